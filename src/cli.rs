@@ -1,0 +1,169 @@
+//! The `dibench` command line.
+
+use crate::error::{Error, Result};
+use crate::harness::{compare, reference};
+use crate::prepare::PreparedScene;
+use crate::scene::Scene;
+use crate::strategy;
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Parser, Debug)]
+#[command(name = "dibench", version, about = "Which direct-illumination sampling strategy wins on this scene, at equal time?")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render every applicable strategy for the same wall-clock budget; write EXRs and results.csv.
+    Compare(CompareArgs),
+    /// Render a high-sample reference image (EXR + JSON metadata) for later comparisons.
+    Reference(ReferenceArgs),
+    /// List the strategies, and which apply to a scene.
+    Strategies {
+        /// Scene file or name under scenes/.
+        scene: Option<String>,
+    },
+}
+
+#[derive(Args, Debug)]
+pub struct Common {
+    /// Scene file, or the name of a scene in scenes/ (e.g. cornell).
+    #[arg(default_value = "cornell")]
+    pub scene: String,
+    /// Output root; results go to <out>/<scene>/...
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Seed of the random streams: same scene, seed and threads give the same image.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Wall-clock budget per strategy, in seconds.
+    #[arg(long, default_value_t = 2.0)]
+    pub time: f64,
+    /// Samples per pixel of the reference rendered when no matching one is stored.
+    #[arg(long, default_value_t = 8192)]
+    pub reference_spp: u64,
+    /// Comma-separated subset of strategies to run (default: every applicable one).
+    #[arg(long, value_delimiter = ',')]
+    pub strategies: Option<Vec<String>>,
+}
+
+#[derive(Args, Debug)]
+pub struct ReferenceArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 8192)]
+    pub spp: u64,
+}
+
+fn load(scene: &str) -> Result<PreparedScene> {
+    let path = Scene::resolve(scene)?;
+    Ok(PreparedScene::new(Scene::load(&path)?))
+}
+
+fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
+    let n = threads.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    if n == 0 {
+        return Err(Error::Usage("--threads must be at least 1".into()));
+    }
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().map_err(|e| Error::Usage(format!("cannot start {n} threads: {e}")))?;
+    Ok((pool, n))
+}
+
+pub fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Compare(a) => run_compare(a),
+        Command::Reference(a) => run_reference(a),
+        Command::Strategies { scene } => run_strategies(scene),
+    }
+}
+
+fn run_reference(a: ReferenceArgs) -> Result<()> {
+    let (pool, threads) = pool(a.common.threads)?;
+    let scene = load(&a.common.scene)?;
+    let (image, meta) = pool.install(|| reference::render(&scene, a.spp, a.common.seed, threads))?;
+    let path = reference::save(&a.common.out, &image, &meta)?;
+    println!("reference: {} ({} spp, {:.1} s, strategy {})", path.display(), meta.spp, meta.wall_time_s, meta.strategy);
+    Ok(())
+}
+
+fn run_compare(a: CompareArgs) -> Result<()> {
+    let (pool, threads) = pool(a.common.threads)?;
+    if !(a.time.is_finite() && a.time > 0.0) {
+        return Err(Error::Usage(format!("--time must be a positive number of seconds, got {}", a.time)));
+    }
+    if a.reference_spp == 0 {
+        return Err(Error::Usage("--reference-spp must be at least 1".into()));
+    }
+    let scene = load(&a.common.scene)?;
+    let (mut run, mut skipped) = strategy::applicable(&scene);
+    if let Some(wanted) = &a.strategies {
+        for w in wanted {
+            if strategy::by_name(w).is_none() {
+                let known: Vec<_> = strategy::registry().iter().map(|s| s.name()).collect();
+                return Err(Error::Usage(format!("unknown strategy `{w}` (known: {})", known.join(", "))));
+            }
+            if let Some((_, why)) = skipped.iter().find(|(n, _)| n == w) {
+                return Err(Error::Usage(format!("strategy `{w}` does not apply to scene `{}`: {why}", scene.scene.name)));
+            }
+        }
+        run.retain(|s| wanted.iter().any(|w| w == s.name()));
+        skipped.retain(|(n, _)| wanted.contains(n));
+    }
+    for (name, why) in &skipped {
+        eprintln!("skipping strategy `{name}`: {why}");
+    }
+    pool.install(|| -> Result<()> {
+        let (reference, ref_meta) = match reference::load_matching(&a.common.out, &scene, a.reference_spp)? {
+            Some(r) => {
+                eprintln!("reference: reusing {} spp from {}", r.1.spp, reference::reference_dir(&a.common.out, &scene.scene.name).display());
+                r
+            }
+            None => {
+                eprintln!("reference: rendering {} spp (no matching one stored)", a.reference_spp);
+                let (img, meta) = reference::render(&scene, a.reference_spp, a.common.seed, threads)?;
+                reference::save(&a.common.out, &img, &meta)?;
+                eprintln!("reference: {:.1} s", meta.wall_time_s);
+                (img, meta)
+            }
+        };
+        let opts = compare::CompareOptions { time_s: a.time, seed: a.common.seed, threads };
+        let report = compare::run(&scene, &run, skipped, &reference, ref_meta.spp, &a.common.out, &opts)?;
+        println!("scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {} spp", scene.scene.name, scene.tracer.name(), threads, a.common.seed, a.time, ref_meta.spp);
+        println!("{:<12} {:>8} {:>9} {:>12} {:>12}", "strategy", "spp", "time_s", "rmse", "relmse");
+        for s in &run {
+            if let Some(last) = report.rows.iter().rev().find(|r| r.strategy == s.name()) {
+                println!("{:<12} {:>8} {:>9.3} {:>12.5e} {:>12.5e}", last.strategy, last.spp, last.time_s, last.rmse, last.relmse);
+            }
+        }
+        println!("results: {}", report.run_dir.display());
+        Ok(())
+    })
+}
+
+fn run_strategies(scene: Option<String>) -> Result<()> {
+    let prepared = scene.as_deref().map(load).transpose()?;
+    for s in strategy::registry() {
+        let status = match &prepared {
+            None => String::new(),
+            Some(p) => match s.applies(p) {
+                Ok(()) => "  [applies]".into(),
+                Err(why) => format!("  [skipped: {why}]"),
+            },
+        };
+        println!("{:<12} {}{status}", s.name(), s.describe());
+    }
+    Ok(())
+}

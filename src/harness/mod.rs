@@ -1,0 +1,30 @@
+//! The benchmark commands: high-sample references and equal-time comparisons.
+
+pub mod compare;
+pub mod reference;
+
+use crate::film::{Film, Image};
+use crate::render::Renderer;
+
+/// Build provenance written into every metadata file.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+pub const COMMIT: &str = env!("DIBENCH_COMMIT");
+
+/// Renders `spp` passes with a renderer; the single place where whole images are made.
+pub fn render_spp(renderer: &Renderer, width: u32, height: u32, spp: u64, mut on_pass: impl FnMut(u64)) -> Image {
+    let mut film = Film::new(width, height);
+    for _ in 0..spp {
+        renderer.add_pass(&mut film);
+        on_pass(film.spp);
+    }
+    film.mean()
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal).
+pub fn progress_bar(len: u64, prefix: String, template: &str) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(len).with_prefix(prefix);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+        bar.set_style(style);
+    }
+    bar
+}

@@ -1,0 +1,22 @@
+//! dibench: a research harness for Monte Carlo direct illumination.
+//!
+//! Data flows one way: [`scene`] (plain data from TOML) → [`prepare`] (only what the scene
+//! needs) → [`tracer`] → [`strategy`] → [`film`] → [`metrics`] → [`output`] (CSV/EXR), driven
+//! by [`harness`].
+
+pub mod bsdf;
+pub mod cli;
+pub mod error;
+pub mod film;
+pub mod geometry;
+pub mod harness;
+pub mod lights;
+pub mod math;
+pub mod metrics;
+pub mod output;
+pub mod prepare;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod strategy;
+pub mod tracer;

@@ -1,0 +1,29 @@
+//! Isotropic point light: intensity I = Φ/(4π); irradiance I·cosθ/d² (inverse-square law).
+
+use super::LightSample;
+use crate::math::luminance;
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct PointLight {
+    pub position: Vec3,
+    pub intensity: Vec3,
+}
+
+impl PointLight {
+    pub fn power(&self) -> f32 {
+        4.0 * std::f32::consts::PI * luminance(self.intensity)
+    }
+
+    /// The only direction there is. None at the light's own position, where I/d² is undefined
+    /// (a measure-zero set of shading points).
+    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+        let d = self.position - p;
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let wi = d / d2.sqrt();
+        Some(LightSample { wi, point: self.position, normal: Vec3::ZERO, radiance: self.intensity / d2, pdf: 1.0 })
+    }
+}

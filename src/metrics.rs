@@ -1,0 +1,44 @@
+//! Image error metrics against a reference, accumulated in f64.
+
+use crate::film::Image;
+
+/// Root-mean-square error over all pixels and channels.
+pub fn rmse(img: &Image, reference: &Image) -> f64 {
+    let n = (img.pixels.len() * 3) as f64;
+    let se: f64 = img
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>())
+        .sum();
+    (se / n).sqrt()
+}
+
+/// Relative MSE, mean over pixels and channels of (x - r)² / (r² + ε) with ε = 0.01
+/// (Rousselle et al. 2011): the ε is part of the metric's definition, so dark pixels do not
+/// dominate.
+pub fn relmse(img: &Image, reference: &Image) -> f64 {
+    const EPS: f64 = 0.01;
+    let n = (img.pixels.len() * 3) as f64;
+    let s: f64 = img
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + EPS)).sum::<f64>())
+        .sum();
+    s / n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_values() {
+        let r = Image { width: 2, height: 1, pixels: vec![[1.0; 3], [0.0; 3]] };
+        let a = Image { width: 2, height: 1, pixels: vec![[1.0; 3], [2.0; 3]] };
+        assert!((rmse(&a, &r) - 2.0f64.sqrt()).abs() < 1e-12);
+        assert!((relmse(&a, &r) - 0.5 * 4.0 / 0.01).abs() < 1e-9);
+        assert_eq!(rmse(&r, &r), 0.0);
+    }
+}

@@ -1,0 +1,144 @@
+//! Scene → what the renderer needs, and only that: the triangles and spheres the tracer
+//! intersects, per-primitive materials, and light structures only for the lights present.
+
+use crate::geometry::sphere::Sphere;
+use crate::geometry::triangle::Triangle;
+use crate::geometry::{Hit, Ray};
+use crate::lights::mesh::MeshLight;
+use crate::lights::point::PointLight;
+use crate::lights::quad::QuadLight;
+use crate::lights::sphere::SphereLight;
+use crate::lights::{Light, LightSample};
+use crate::sampling::discrete::DiscreteDistribution;
+use crate::scene::Scene;
+use crate::tracer::bvh::ObvhsTracer;
+use crate::tracer::{Geometry, Tracer};
+use glam::Vec3;
+use std::sync::Arc;
+
+/// Which light (and, for a mesh light, which of its triangles) a primitive emits as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EmitterRef {
+    pub light: u32,
+    pub local: u32,
+}
+
+pub struct PreparedScene {
+    pub scene: Scene,
+    pub geometry: Arc<Geometry>,
+    pub tracer: Box<dyn Tracer>,
+    pub prim_material: Vec<u32>,
+    pub prim_emitter: Vec<Option<EmitterRef>>,
+    pub lights: Vec<Light>,
+    /// Power-proportional light selection; None when no light has positive power.
+    pub light_selection: Option<DiscreteDistribution>,
+}
+
+/// A surface point hit by a ray.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub p: Vec3,
+    /// Unit geometric normal: the winding's side for triangles, outward for spheres.
+    pub ng: Vec3,
+    pub material: u32,
+    pub emitter: Option<EmitterRef>,
+}
+
+impl PreparedScene {
+    pub fn new(scene: Scene) -> Self {
+        Self::with_tracer(scene, |g| Box::new(ObvhsTracer::build(g)))
+    }
+
+    /// Prepares with a tracer of the caller's choice (a backend built over the same geometry).
+    pub fn with_tracer(scene: Scene, make_tracer: impl FnOnce(Arc<Geometry>) -> Box<dyn Tracer>) -> Self {
+        let mut g = Geometry::default();
+        let mut prim_material = Vec::new();
+        let mut prim_emitter = Vec::new();
+        let mut lights = Vec::new();
+
+        for mesh in &scene.meshes {
+            let tris: Vec<Triangle> = mesh
+                .triangles
+                .iter()
+                .map(|t| Triangle::new(mesh.positions[t[0] as usize], mesh.positions[t[1] as usize], mesh.positions[t[2] as usize]))
+                .collect();
+            let light = mesh.emission.and_then(|l| MeshLight::new(tris.clone(), l)).map(|m| {
+                lights.push(Light::Mesh(m));
+                lights.len() as u32 - 1
+            });
+            for (k, t) in tris.into_iter().enumerate() {
+                g.triangles.push(t);
+                prim_material.push(mesh.material);
+                prim_emitter.push(light.map(|light| EmitterRef { light, local: k as u32 }));
+            }
+        }
+        for q in &scene.quads {
+            let light = q.emission.map(|l| {
+                lights.push(Light::Quad(QuadLight::new(q.corner, q.edge_u, q.edge_v, l)));
+                lights.len() as u32 - 1
+            });
+            let (c, u, v) = (q.corner, q.edge_u, q.edge_v);
+            // Both triangles keep the winding of edge_u × edge_v.
+            for t in [Triangle::new(c, c + u, c + u + v), Triangle::new(c, c + u + v, c + v)] {
+                g.triangles.push(t);
+                prim_material.push(q.material);
+                prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
+            }
+        }
+        for s in &scene.spheres {
+            let light = s.emission.map(|l| {
+                lights.push(Light::Sphere(SphereLight { center: s.center, radius: s.radius, radiance: l }));
+                lights.len() as u32 - 1
+            });
+            g.spheres.push(Sphere { center: s.center, radius: s.radius });
+            prim_material.push(s.material);
+            prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
+        }
+        for p in &scene.point_lights {
+            lights.push(Light::Point(PointLight { position: p.position, intensity: p.intensity }));
+        }
+
+        let light_selection = if lights.is_empty() {
+            None
+        } else {
+            DiscreteDistribution::new(&lights.iter().map(Light::power).collect::<Vec<_>>())
+        };
+        let geometry = Arc::new(g);
+        let tracer = make_tracer(geometry.clone());
+        PreparedScene { scene, geometry, tracer, prim_material, prim_emitter, lights, light_selection }
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
+        let (p, ng) = match self.geometry.sphere_index(hit.prim) {
+            None => {
+                let t = &self.geometry.triangles[hit.prim as usize];
+                // Barycentric position: more accurate than o + t·d, which matters for offsets.
+                (t.point(hit.u, hit.v), t.cross().normalize())
+            }
+            Some(s) => {
+                let s = &self.geometry.spheres[s];
+                let p = s.project(ray.at(hit.t));
+                (p, s.normal_at(p))
+            }
+        };
+        SurfaceHit { p, ng, material: self.prim_material[hit.prim as usize], emitter: self.prim_emitter[hit.prim as usize] }
+    }
+
+    /// Radiance an emitter primitive sends back along a ray that hit it.
+    pub fn emitted(&self, surface: &SurfaceHit, ray_dir: Vec3) -> Vec3 {
+        match surface.emitter {
+            Some(e) => self.lights[e.light as usize].emitted(surface.ng, -ray_dir),
+            None => Vec3::ZERO,
+        }
+    }
+
+    /// Picks a light by power and samples it with its default sampler; the returned pdf
+    /// includes the selection probability.
+    pub fn sample_light(&self, p: Vec3, u_select: f32, u: [f32; 3]) -> Option<(usize, LightSample)> {
+        let sel = self.light_selection.as_ref()?;
+        let i = sel.sample(u_select);
+        let mut s = self.lights[i].sample(p, u)?;
+        s.pdf *= sel.pmf(i);
+        Some((i, s))
+    }
+}

@@ -1,0 +1,123 @@
+//! One sample per pixel over the whole image, in 4×4 tiles: a 16-ray camera packet, then the
+//! strategy's shadow and emission probes as two more packets. Parallel over tiles with rayon.
+
+use crate::film::{Film, TileLayout};
+use crate::geometry::Ray;
+use crate::math::offset_ray_origin;
+use crate::prepare::PreparedScene;
+use crate::sampling::stream::{SampleStream, name_id};
+use crate::scene::Camera;
+use crate::strategy::{ShadingPoint, Strategy};
+use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
+use glam::Vec3;
+use rayon::prelude::*;
+
+pub struct Renderer<'a> {
+    pub scene: &'a PreparedScene,
+    pub strategy: &'a dyn Strategy,
+    pub seed: u64,
+    strategy_id: u64,
+}
+
+impl<'a> Renderer<'a> {
+    pub fn new(scene: &'a PreparedScene, strategy: &'a dyn Strategy, seed: u64) -> Self {
+        Renderer { scene, strategy, seed, strategy_id: name_id(strategy.name()) }
+    }
+
+    /// Adds one sample per pixel to the film; pass `film.spp` numbers the random streams, so
+    /// the result is independent of thread count and scheduling.
+    pub fn add_pass(&self, film: &mut Film) {
+        let pass = film.spp;
+        let layout = film.layout;
+        film.sum.par_chunks_mut(16).enumerate().for_each(|(tile, out)| {
+            let radiance = self.render_tile(&layout, tile, pass);
+            for (o, l) in out.iter_mut().zip(radiance.iter()) {
+                o[0] += l.x as f64;
+                o[1] += l.y as f64;
+                o[2] += l.z as f64;
+            }
+        });
+        film.spp += 1;
+    }
+
+    fn render_tile(&self, shape: &TileLayout, tile: usize, pass: u64) -> [Vec3; LANES] {
+        let scene = self.scene;
+        let camera = &scene.scene.camera;
+        let (w, h) = (shape.width, shape.height);
+        let mut radiance = [Vec3::ZERO; LANES];
+        let mut rngs: [Option<SampleStream>; LANES] = Default::default();
+        let mut cam = RayPacket::default();
+        let mut active: LaneMask = 0;
+        for lane in 0..LANES {
+            if let Some((x, y)) = shape.lane_pixel(tile, lane) {
+                let pixel = y as u64 * w as u64 + x as u64;
+                let mut rng = SampleStream::new(self.seed, self.strategy_id, pixel, pass);
+                let ray = camera_ray(camera, w, h, x, y, rng.next_2d());
+                cam.set(lane, &ray);
+                rngs[lane] = Some(rng);
+                active |= 1 << lane;
+            }
+        }
+        let mut hits = HitPacket::default();
+        scene.tracer.intersect_packet(&cam, active, &mut hits);
+
+        let mut shadow = RayPacket::default();
+        let mut shadow_value = [Vec3::ZERO; LANES];
+        let mut shadow_mask: LaneMask = 0;
+        let mut emit = RayPacket::default();
+        let mut emit_weight = [Vec3::ZERO; LANES];
+        let mut emit_mask: LaneMask = 0;
+        for lane in 0..LANES {
+            let (Some(hit), Some(rng)) = (hits.get(lane), rngs[lane].as_mut()) else { continue };
+            let ray = cam.get(lane);
+            let surf = scene.surface(&ray, &hit);
+            radiance[lane] += scene.emitted(&surf, ray.dir);
+            let n = if surf.ng.dot(ray.dir) < 0.0 { surf.ng } else { -surf.ng };
+            let sp = ShadingPoint {
+                p: surf.p,
+                origin: offset_ray_origin(surf.p, n),
+                n,
+                albedo: scene.scene.materials[surf.material as usize].albedo,
+            };
+            let probes = self.strategy.sample(scene, &sp, rng);
+            if let Some(s) = probes.shadow {
+                shadow.set(lane, &s.ray);
+                shadow_value[lane] = s.value;
+                shadow_mask |= 1 << lane;
+            }
+            if let Some(e) = probes.emission {
+                emit.set(lane, &e.ray);
+                emit_weight[lane] = e.weight;
+                emit_mask |= 1 << lane;
+            }
+        }
+        if shadow_mask != 0 {
+            let blocked = scene.tracer.occluded_packet(&shadow, shadow_mask);
+            for lane in 0..LANES {
+                if shadow_mask & !blocked & (1 << lane) != 0 {
+                    radiance[lane] += shadow_value[lane];
+                }
+            }
+        }
+        if emit_mask != 0 {
+            let mut ehits = HitPacket::default();
+            scene.tracer.intersect_packet(&emit, emit_mask, &mut ehits);
+            for lane in 0..LANES {
+                if let Some(hit) = ehits.get(lane) {
+                    let ray = emit.get(lane);
+                    let surf = scene.surface(&ray, &hit);
+                    radiance[lane] += emit_weight[lane] * scene.emitted(&surf, ray.dir);
+                }
+            }
+        }
+        radiance
+    }
+}
+
+/// Pinhole camera ray through pixel (x, y) at sub-pixel offset `u` (a box filter).
+pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ray {
+    let aspect = w as f32 / h as f32;
+    let sx = (2.0 * (x as f32 + u[0]) / w as f32 - 1.0) * aspect * c.tan_half_fov_y;
+    let sy = (1.0 - 2.0 * (y as f32 + u[1]) / h as f32) * c.tan_half_fov_y;
+    Ray::new(c.eye, (c.forward + c.right * sx + c.up * sy).normalize(), f32::INFINITY)
+}

@@ -1,0 +1,117 @@
+//! The TOML scene format, as serde structs. Unknown keys are errors (`deny_unknown_fields`):
+//! a misspelt key silently ignored would change the experiment without telling anyone.
+//! Units and conventions: `docs/conventions.md`.
+
+use serde::Deserialize;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    pub camera: CameraDesc,
+    pub image: ImageDesc,
+    #[serde(default, rename = "material")]
+    pub materials: Vec<MaterialDesc>,
+    #[serde(default, rename = "mesh")]
+    pub meshes: Vec<MeshDesc>,
+    #[serde(default, rename = "quad")]
+    pub quads: Vec<QuadDesc>,
+    #[serde(default, rename = "sphere")]
+    pub spheres: Vec<SphereDesc>,
+    #[serde(default, rename = "point_light")]
+    pub point_lights: Vec<PointLightDesc>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    pub eye: [f32; 3],
+    pub look_at: [f32; 3],
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    /// Full vertical field of view in degrees.
+    pub fov_y_deg: f32,
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImageDesc {
+    pub width: u32,
+    pub height: u32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    pub name: String,
+    /// Lambertian reflectance in [0, 1] per channel.
+    pub albedo: [f32; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDesc {
+    /// OBJ file, relative to the scene file.
+    pub file: String,
+    pub material: String,
+    #[serde(default)]
+    pub transform: TransformDesc,
+    /// Emitted radiance [W/(m² sr)] on the front faces (counter-clockwise winding) makes
+    /// this mesh a light.
+    pub emission: Option<[f32; 3]>,
+}
+
+/// Applied as scale, then rotation about +Y, then translation.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    #[serde(default = "one")]
+    pub scale: f32,
+    #[serde(default)]
+    pub rotate_y_deg: f32,
+    #[serde(default)]
+    pub translate: [f32; 3],
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+impl Default for TransformDesc {
+    fn default() -> Self {
+        TransformDesc { scale: 1.0, rotate_y_deg: 0.0, translate: [0.0; 3] }
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadDesc {
+    /// The parallelogram corner + s·edge_u + t·edge_v, s, t in [0, 1]. Its front side (the side
+    /// that emits) is the side of edge_u × edge_v.
+    pub corner: [f32; 3],
+    pub edge_u: [f32; 3],
+    pub edge_v: [f32; 3],
+    pub material: String,
+    pub emission: Option<[f32; 3]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDesc {
+    pub center: [f32; 3],
+    pub radius: f32,
+    pub material: String,
+    /// Emitted radiance, on both faces: outward, and inward for points inside the sphere.
+    pub emission: Option<[f32; 3]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightDesc {
+    pub position: [f32; 3],
+    /// Radiant power Φ [W] per channel; the intensity is Φ/(4π) [W/sr].
+    pub power: [f32; 3],
+}

@@ -1,0 +1,287 @@
+//! The scene as plain data, loaded and validated from a TOML file (format: `scene::file`).
+//! Nothing here is derived for rendering; `prepare` builds only what a scene needs.
+
+pub mod file;
+mod obj;
+
+use crate::error::{Error, Result};
+use file::SceneFile;
+use glam::{Quat, Vec3};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub name: String,
+    pub path: PathBuf,
+    /// SHA-256 over the scene file and every file it references: a reference image is reused
+    /// only for the exact same content.
+    pub content_hash: String,
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+    pub materials: Vec<Material>,
+    pub meshes: Vec<Mesh>,
+    pub quads: Vec<Quad>,
+    pub spheres: Vec<SphereShape>,
+    pub point_lights: Vec<PointLight>,
+}
+
+/// Pinhole camera, right-handed: `forward` = normalize(look_at - eye), `right` = forward × up.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub forward: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+    /// tan(fov_y / 2): the vertical field of view is the one stated in the file.
+    pub tan_half_fov_y: f32,
+}
+
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    pub albedo: Vec3,
+}
+
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    pub file: PathBuf,
+    pub positions: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+    pub material: u32,
+    pub emission: Option<Vec3>,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Quad {
+    pub corner: Vec3,
+    pub edge_u: Vec3,
+    pub edge_v: Vec3,
+    pub material: u32,
+    pub emission: Option<Vec3>,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct SphereShape {
+    pub center: Vec3,
+    pub radius: f32,
+    pub material: u32,
+    pub emission: Option<Vec3>,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct PointLight {
+    pub position: Vec3,
+    /// Radiant intensity I = Φ/(4π) [W/sr].
+    pub intensity: Vec3,
+}
+
+impl Scene {
+    pub fn has_emitters(&self) -> bool {
+        self.meshes.iter().any(|m| m.emission.is_some())
+            || self.quads.iter().any(|q| q.emission.is_some())
+            || self.spheres.iter().any(|s| s.emission.is_some())
+    }
+
+    pub fn has_delta_lights(&self) -> bool {
+        !self.point_lights.is_empty()
+    }
+
+    pub fn pixel_count(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    /// Finds a scene by path, or by name under `scenes/` (in the working directory, then in the
+    /// source tree this binary was built from).
+    pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
+        let direct = PathBuf::from(name_or_path);
+        if direct.is_file() {
+            return Ok(direct);
+        }
+        let file = if name_or_path.ends_with(".toml") { name_or_path.to_string() } else { format!("{name_or_path}.toml") };
+        for root in [PathBuf::from("scenes"), Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")] {
+            let candidate = root.join(&file);
+            if candidate.is_file() {
+                return Ok(candidate);
+            }
+        }
+        let known = Self::builtin_names().join(", ");
+        Err(Error::Usage(format!("no scene file `{name_or_path}` and no scene of that name in scenes/ (known: {known})")))
+    }
+
+    /// The names of the scenes shipped in `scenes/`.
+    pub fn builtin_names() -> Vec<String> {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter_map(|e| {
+                let p = e.path();
+                if p.extension()? == "toml" { Some(p.file_stem()?.to_string_lossy().into_owned()) } else { None }
+            })
+            .collect();
+        names.sort();
+        names
+    }
+
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let desc: SceneFile =
+            toml::from_str(&text).map_err(|e| Error::Parse { path: path.to_path_buf(), message: e.to_string() })?;
+        let mut hasher = Sha256::new();
+        hasher.update(text.as_bytes());
+        let base = path.parent().unwrap_or(Path::new("."));
+        let v = Validator { path };
+
+        let camera = v.camera(&desc.camera)?;
+        if desc.image.width == 0 || desc.image.height == 0 || desc.image.width > 16384 || desc.image.height > 16384 {
+            return Err(Error::field(path, "image", format!("width and height must be in 1..=16384, got {}×{}", desc.image.width, desc.image.height)));
+        }
+
+        let mut materials = Vec::new();
+        for (i, m) in desc.materials.iter().enumerate() {
+            let field = format!("material[{i}].albedo");
+            let albedo = v.vec3(&field, m.albedo)?;
+            if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
+                return Err(Error::field(path, field, "albedo must be in [0, 1] (energy conservation)"));
+            }
+            if materials.iter().any(|x: &Material| x.name == m.name) {
+                return Err(Error::field(path, format!("material[{i}].name"), format!("duplicate material `{}`", m.name)));
+            }
+            materials.push(Material { name: m.name.clone(), albedo });
+        }
+        let material = |field: String, name: &str| -> Result<u32> {
+            materials.iter().position(|m| m.name == name).map(|i| i as u32).ok_or_else(|| {
+                let known: Vec<_> = materials.iter().map(|m| m.name.as_str()).collect();
+                Error::field(path, field, format!("unknown material `{name}` (defined: {})", known.join(", ")))
+            })
+        };
+
+        let mut meshes = Vec::new();
+        for (i, m) in desc.meshes.iter().enumerate() {
+            let file = base.join(&m.file);
+            let bytes = std::fs::read(&file).map_err(|e| Error::field(path, format!("mesh[{i}].file"), format!("cannot read {}: {e}", file.display())))?;
+            hasher.update(&bytes);
+            let (mut positions, triangles) = obj::load(&file)?;
+            let t = &m.transform;
+            if !(t.scale.is_finite() && t.scale > 0.0) {
+                return Err(Error::field(path, format!("mesh[{i}].transform.scale"), "must be finite and positive"));
+            }
+            let translate = v.vec3(&format!("mesh[{i}].transform.translate"), t.translate)?;
+            let rot = Quat::from_rotation_y(v.finite(&format!("mesh[{i}].transform.rotate_y_deg"), t.rotate_y_deg)?.to_radians());
+            for p in &mut positions {
+                *p = rot * (*p * t.scale) + translate;
+            }
+            meshes.push(Mesh {
+                file,
+                positions,
+                triangles,
+                material: material(format!("mesh[{i}].material"), &m.material)?,
+                emission: v.emission(&format!("mesh[{i}].emission"), m.emission)?,
+            });
+        }
+
+        let mut quads = Vec::new();
+        for (i, q) in desc.quads.iter().enumerate() {
+            let quad = Quad {
+                corner: v.vec3(&format!("quad[{i}].corner"), q.corner)?,
+                edge_u: v.vec3(&format!("quad[{i}].edge_u"), q.edge_u)?,
+                edge_v: v.vec3(&format!("quad[{i}].edge_v"), q.edge_v)?,
+                material: material(format!("quad[{i}].material"), &q.material)?,
+                emission: v.emission(&format!("quad[{i}].emission"), q.emission)?,
+            };
+            if quad.edge_u.cross(quad.edge_v).length_squared() == 0.0 {
+                return Err(Error::field(path, format!("quad[{i}]"), "edge_u and edge_v are parallel or zero: the quad has no area"));
+            }
+            quads.push(quad);
+        }
+
+        let mut spheres = Vec::new();
+        for (i, s) in desc.spheres.iter().enumerate() {
+            let radius = v.finite(&format!("sphere[{i}].radius"), s.radius)?;
+            if radius <= 0.0 {
+                return Err(Error::field(path, format!("sphere[{i}].radius"), "must be positive"));
+            }
+            spheres.push(SphereShape {
+                center: v.vec3(&format!("sphere[{i}].center"), s.center)?,
+                radius,
+                material: material(format!("sphere[{i}].material"), &s.material)?,
+                emission: v.emission(&format!("sphere[{i}].emission"), s.emission)?,
+            });
+        }
+
+        let mut point_lights = Vec::new();
+        for (i, l) in desc.point_lights.iter().enumerate() {
+            let power = v.vec3(&format!("point_light[{i}].power"), l.power)?;
+            if power.min_element() < 0.0 {
+                return Err(Error::field(path, format!("point_light[{i}].power"), "must be non-negative"));
+            }
+            point_lights.push(PointLight {
+                position: v.vec3(&format!("point_light[{i}].position"), l.position)?,
+                intensity: power / (4.0 * std::f32::consts::PI),
+            });
+        }
+
+        let scene = Scene {
+            name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into()),
+            path: path.to_path_buf(),
+            content_hash: format!("{:x}", hasher.finalize()),
+            camera,
+            width: desc.image.width,
+            height: desc.image.height,
+            materials,
+            meshes,
+            quads,
+            spheres,
+            point_lights,
+        };
+        if !scene.has_emitters() && !scene.has_delta_lights() {
+            return Err(Error::field(path, "light", "the scene has no light: add an `emission` to a shape or a [[point_light]]"));
+        }
+        Ok(scene)
+    }
+}
+
+struct Validator<'a> {
+    path: &'a Path,
+}
+
+impl Validator<'_> {
+    fn finite(&self, field: &str, x: f32) -> Result<f32> {
+        if x.is_finite() { Ok(x) } else { Err(Error::field(self.path, field, format!("must be finite, got {x}"))) }
+    }
+
+    fn vec3(&self, field: &str, a: [f32; 3]) -> Result<Vec3> {
+        if a.iter().all(|c| c.is_finite()) { Ok(Vec3::from_array(a)) } else { Err(Error::field(self.path, field, format!("must be finite, got {a:?}"))) }
+    }
+
+    fn emission(&self, field: &str, e: Option<[f32; 3]>) -> Result<Option<Vec3>> {
+        let Some(e) = e else { return Ok(None) };
+        let e = self.vec3(field, e)?;
+        if e.min_element() < 0.0 {
+            return Err(Error::field(self.path, field, format!("radiance must be non-negative, got {e}")));
+        }
+        Ok(Some(e))
+    }
+
+    fn camera(&self, c: &file::CameraDesc) -> Result<Camera> {
+        let eye = self.vec3("camera.eye", c.eye)?;
+        let look_at = self.vec3("camera.look_at", c.look_at)?;
+        let up = self.vec3("camera.up", c.up)?;
+        let fov = self.finite("camera.fov_y_deg", c.fov_y_deg)?;
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(Error::field(self.path, "camera.fov_y_deg", format!("must be in (0, 180), got {fov}")));
+        }
+        let forward = (look_at - eye).normalize_or_zero();
+        if forward == Vec3::ZERO {
+            return Err(Error::field(self.path, "camera.look_at", "equals camera.eye"));
+        }
+        let right = forward.cross(up).normalize_or_zero();
+        if right == Vec3::ZERO {
+            return Err(Error::field(self.path, "camera.up", "is parallel to the viewing direction"));
+        }
+        Ok(Camera { eye, forward, right, up: right.cross(forward), tan_half_fov_y: (0.5 * fov.to_radians()).tan() })
+    }
+}

@@ -1,0 +1,152 @@
+//! The tracer interface, shaped for packets: closest-hit and occlusion for single rays and for
+//! 16-ray SoA packets with an active-lane mask. Strategies and the renderer see only this
+//! trait, so the SIMD packet core and Embree drop in behind it.
+
+pub mod bvh;
+
+use crate::geometry::sphere::Sphere;
+use crate::geometry::triangle::Triangle;
+use crate::geometry::{Hit, Ray};
+use glam::Vec3;
+
+pub const LANES: usize = 16;
+
+/// Bit i set = lane i active.
+pub type LaneMask = u16;
+
+pub const ALL_LANES: LaneMask = u16::MAX;
+
+/// 16 rays, structure-of-arrays, 64-byte aligned so a lane array is one AVX-512 register or
+/// two AVX2 registers.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct RayPacket {
+    pub ox: [f32; LANES],
+    pub oy: [f32; LANES],
+    pub oz: [f32; LANES],
+    pub dx: [f32; LANES],
+    pub dy: [f32; LANES],
+    pub dz: [f32; LANES],
+    pub tmax: [f32; LANES],
+}
+
+impl Default for RayPacket {
+    fn default() -> Self {
+        RayPacket {
+            ox: [0.0; LANES],
+            oy: [0.0; LANES],
+            oz: [0.0; LANES],
+            dx: [0.0; LANES],
+            dy: [0.0; LANES],
+            dz: [1.0; LANES],
+            tmax: [0.0; LANES],
+        }
+    }
+}
+
+impl RayPacket {
+    pub fn set(&mut self, lane: usize, ray: &Ray) {
+        self.ox[lane] = ray.origin.x;
+        self.oy[lane] = ray.origin.y;
+        self.oz[lane] = ray.origin.z;
+        self.dx[lane] = ray.dir.x;
+        self.dy[lane] = ray.dir.y;
+        self.dz[lane] = ray.dir.z;
+        self.tmax[lane] = ray.tmax;
+    }
+
+    pub fn get(&self, lane: usize) -> Ray {
+        Ray::new(
+            Vec3::new(self.ox[lane], self.oy[lane], self.oz[lane]),
+            Vec3::new(self.dx[lane], self.dy[lane], self.dz[lane]),
+            self.tmax[lane],
+        )
+    }
+}
+
+/// Closest hits of a packet; `prim[lane] == NO_HIT` where the lane missed or was inactive.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct HitPacket {
+    pub t: [f32; LANES],
+    pub u: [f32; LANES],
+    pub v: [f32; LANES],
+    pub prim: [u32; LANES],
+}
+
+pub const NO_HIT: u32 = u32::MAX;
+
+impl Default for HitPacket {
+    fn default() -> Self {
+        HitPacket { t: [f32::INFINITY; LANES], u: [0.0; LANES], v: [0.0; LANES], prim: [NO_HIT; LANES] }
+    }
+}
+
+impl HitPacket {
+    pub fn get(&self, lane: usize) -> Option<Hit> {
+        (self.prim[lane] != NO_HIT).then(|| Hit { t: self.t[lane], prim: self.prim[lane], u: self.u[lane], v: self.v[lane] })
+    }
+
+    pub fn set(&mut self, lane: usize, hit: Option<Hit>) {
+        match hit {
+            Some(h) => {
+                self.t[lane] = h.t;
+                self.u[lane] = h.u;
+                self.v[lane] = h.v;
+                self.prim[lane] = h.prim;
+            }
+            None => {
+                self.t[lane] = f32::INFINITY;
+                self.prim[lane] = NO_HIT;
+            }
+        }
+    }
+}
+
+/// What every backend traces: triangles get primitive ids `0..triangles.len()`, spheres the
+/// ids after them.
+#[derive(Clone, Debug, Default)]
+pub struct Geometry {
+    pub triangles: Vec<Triangle>,
+    pub spheres: Vec<Sphere>,
+}
+
+impl Geometry {
+    pub fn prim_count(&self) -> usize {
+        self.triangles.len() + self.spheres.len()
+    }
+
+    /// Sphere index of a primitive id, if it is a sphere.
+    pub fn sphere_index(&self, prim: u32) -> Option<usize> {
+        (prim as usize).checked_sub(self.triangles.len())
+    }
+}
+
+pub trait Tracer: Send + Sync {
+    /// Short backend name for CSV columns (`obvhs`, `packet`, `embree`).
+    fn name(&self) -> &'static str;
+
+    fn intersect(&self, ray: &Ray) -> Option<Hit>;
+
+    /// True if anything lies on the open segment (0, ray.tmax).
+    fn occluded(&self, ray: &Ray) -> bool;
+
+    /// Closest hits of the active lanes; inactive lanes come back as misses.
+    fn intersect_packet(&self, rays: &RayPacket, active: LaneMask, hits: &mut HitPacket) {
+        for lane in 0..LANES {
+            let hit = if active & (1 << lane) != 0 { self.intersect(&rays.get(lane)) } else { None };
+            hits.set(lane, hit);
+        }
+    }
+
+    /// The mask of active lanes that are occluded.
+    fn occluded_packet(&self, rays: &RayPacket, active: LaneMask) -> LaneMask {
+        let mut out = 0;
+        for lane in 0..LANES {
+            if active & (1 << lane) != 0 && self.occluded(&rays.get(lane)) {
+                out |= 1 << lane;
+            }
+        }
+        out
+    }
+}
