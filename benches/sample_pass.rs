@@ -1,1 +1,31 @@
-fn main(){}
+//! Cost of one sample pass (one sample per pixel over the whole image) per strategy per scene:
+//! the t_sample in Veach's efficiency 1/(σ²·t_sample).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use dibench::film::Film;
+use dibench::prepare::PreparedScene;
+use dibench::render::Renderer;
+use dibench::scene::Scene;
+use dibench::strategy::applicable;
+use std::time::Duration;
+
+fn sample_pass(c: &mut Criterion) {
+    for name in Scene::builtin_names() {
+        let scene = PreparedScene::new(Scene::load(&Scene::resolve(&name).unwrap()).unwrap());
+        let (strategies, _) = applicable(&scene);
+        let mut group = c.benchmark_group(format!("sample_pass/{name}"));
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(300))
+            .measurement_time(Duration::from_secs(2));
+        for s in &strategies {
+            let renderer = Renderer::new(&scene, s.as_ref(), 1);
+            let mut film = Film::new(scene.scene.width, scene.scene.height);
+            group.bench_function(s.name(), |b| b.iter(|| renderer.add_pass(&mut film)));
+        }
+        group.finish();
+    }
+}
+
+criterion_group!(benches, sample_pass);
+criterion_main!(benches);

@@ -9,7 +9,11 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
-#[command(name = "dibench", version, about = "Which direct-illumination sampling strategy wins on this scene, at equal time?")]
+#[command(
+    name = "dibench",
+    version,
+    about = "Which direct-illumination sampling strategy wins on this scene, at equal time?"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -49,7 +53,7 @@ pub struct CompareArgs {
     #[command(flatten)]
     pub common: Common,
     /// Wall-clock budget per strategy, in seconds.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub time: f64,
     /// Samples per pixel of the reference rendered when no matching one is stored.
     #[arg(long, default_value_t = 8192)]
@@ -74,11 +78,18 @@ fn load(scene: &str) -> Result<PreparedScene> {
 }
 
 fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
-    let n = threads.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    let n = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
     if n == 0 {
         return Err(Error::Usage("--threads must be at least 1".into()));
     }
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().map_err(|e| Error::Usage(format!("cannot start {n} threads: {e}")))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| Error::Usage(format!("cannot start {n} threads: {e}")))?;
     Ok((pool, n))
 }
 
@@ -93,16 +104,26 @@ pub fn run(cli: Cli) -> Result<()> {
 fn run_reference(a: ReferenceArgs) -> Result<()> {
     let (pool, threads) = pool(a.common.threads)?;
     let scene = load(&a.common.scene)?;
-    let (image, meta) = pool.install(|| reference::render(&scene, a.spp, a.common.seed, threads))?;
+    let (image, meta) =
+        pool.install(|| reference::render(&scene, a.spp, a.common.seed, threads))?;
     let path = reference::save(&a.common.out, &image, &meta)?;
-    println!("reference: {} ({} spp, {:.1} s, strategy {})", path.display(), meta.spp, meta.wall_time_s, meta.strategy);
+    println!(
+        "reference: {} ({} spp, {:.1} s, strategy {})",
+        path.display(),
+        meta.spp,
+        meta.wall_time_s,
+        meta.strategy
+    );
     Ok(())
 }
 
 fn run_compare(a: CompareArgs) -> Result<()> {
     let (pool, threads) = pool(a.common.threads)?;
     if !(a.time.is_finite() && a.time > 0.0) {
-        return Err(Error::Usage(format!("--time must be a positive number of seconds, got {}", a.time)));
+        return Err(Error::Usage(format!(
+            "--time must be a positive number of seconds, got {}",
+            a.time
+        )));
     }
     if a.reference_spp == 0 {
         return Err(Error::Usage("--reference-spp must be at least 1".into()));
@@ -113,39 +134,80 @@ fn run_compare(a: CompareArgs) -> Result<()> {
         for w in wanted {
             if strategy::by_name(w).is_none() {
                 let known: Vec<_> = strategy::registry().iter().map(|s| s.name()).collect();
-                return Err(Error::Usage(format!("unknown strategy `{w}` (known: {})", known.join(", "))));
+                return Err(Error::Usage(format!(
+                    "unknown strategy `{w}` (known: {})",
+                    known.join(", ")
+                )));
             }
-            if let Some((_, why)) = skipped.iter().find(|(n, _)| n == w) {
-                return Err(Error::Usage(format!("strategy `{w}` does not apply to scene `{}`: {why}", scene.scene.name)));
+            if let Some(skip) = skipped.iter().find(|k| &k.name == w) {
+                return Err(Error::Usage(format!(
+                    "strategy `{w}` does not apply to scene `{}`: {}",
+                    scene.scene.name, skip.reason
+                )));
             }
         }
         run.retain(|s| wanted.iter().any(|w| w == s.name()));
-        skipped.retain(|(n, _)| wanted.contains(n));
+        skipped.retain(|k| wanted.contains(&k.name));
     }
-    for (name, why) in &skipped {
-        eprintln!("skipping strategy `{name}`: {why}");
+    for k in &skipped {
+        eprintln!("skipping strategy `{}`: {}", k.name, k.reason);
     }
     pool.install(|| -> Result<()> {
-        let (reference, ref_meta) = match reference::load_matching(&a.common.out, &scene, a.reference_spp)? {
-            Some(r) => {
-                eprintln!("reference: reusing {} spp from {}", r.1.spp, reference::reference_dir(&a.common.out, &scene.scene.name).display());
-                r
-            }
-            None => {
-                eprintln!("reference: rendering {} spp (no matching one stored)", a.reference_spp);
-                let (img, meta) = reference::render(&scene, a.reference_spp, a.common.seed, threads)?;
-                reference::save(&a.common.out, &img, &meta)?;
-                eprintln!("reference: {:.1} s", meta.wall_time_s);
-                (img, meta)
-            }
+        let (reference, ref_meta) =
+            match reference::load_matching(&a.common.out, &scene, a.reference_spp)? {
+                Some(r) => {
+                    eprintln!(
+                        "reference: reusing {} spp from {}",
+                        r.1.spp,
+                        reference::reference_dir(&a.common.out, &scene.scene.name).display()
+                    );
+                    r
+                }
+                None => {
+                    eprintln!(
+                        "reference: rendering {} spp (no matching one stored)",
+                        a.reference_spp
+                    );
+                    let (img, meta) =
+                        reference::render(&scene, a.reference_spp, a.common.seed, threads)?;
+                    reference::save(&a.common.out, &img, &meta)?;
+                    eprintln!("reference: {:.1} s", meta.wall_time_s);
+                    (img, meta)
+                }
+            };
+        let opts = compare::CompareOptions {
+            time_s: a.time,
+            seed: a.common.seed,
+            threads,
         };
-        let opts = compare::CompareOptions { time_s: a.time, seed: a.common.seed, threads };
-        let report = compare::run(&scene, &run, skipped, &reference, ref_meta.spp, &a.common.out, &opts)?;
-        println!("scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {} spp", scene.scene.name, scene.tracer.name(), threads, a.common.seed, a.time, ref_meta.spp);
-        println!("{:<12} {:>8} {:>9} {:>12} {:>12}", "strategy", "spp", "time_s", "rmse", "relmse");
+        let report = compare::run(
+            &scene,
+            &run,
+            skipped,
+            &reference,
+            ref_meta.spp,
+            &a.common.out,
+            &opts,
+        )?;
+        println!(
+            "scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {} spp",
+            scene.scene.name,
+            scene.tracer.name(),
+            threads,
+            a.common.seed,
+            a.time,
+            ref_meta.spp
+        );
+        println!(
+            "{:<12} {:>8} {:>9} {:>12} {:>12}",
+            "strategy", "spp", "time_s", "rmse", "relmse"
+        );
         for s in &run {
             if let Some(last) = report.rows.iter().rev().find(|r| r.strategy == s.name()) {
-                println!("{:<12} {:>8} {:>9.3} {:>12.5e} {:>12.5e}", last.strategy, last.spp, last.time_s, last.rmse, last.relmse);
+                println!(
+                    "{:<12} {:>8} {:>9.3} {:>12.5e} {:>12.5e}",
+                    last.strategy, last.spp, last.time_s, last.rmse, last.relmse
+                );
             }
         }
         println!("results: {}", report.run_dir.display());

@@ -15,7 +15,11 @@ pub struct TileLayout {
 
 impl TileLayout {
     pub fn new(width: u32, height: u32) -> Self {
-        TileLayout { width, height, tiles_x: width.div_ceil(TILE) }
+        TileLayout {
+            width,
+            height,
+            tiles_x: width.div_ceil(TILE),
+        }
     }
 
     pub fn tile_count(&self) -> usize {
@@ -25,7 +29,10 @@ impl TileLayout {
     /// Pixel coordinates of lane `lane` of tile `tile`, or None past the image edge.
     pub fn lane_pixel(&self, tile: usize, lane: usize) -> Option<(u32, u32)> {
         let (tx, ty) = (tile as u32 % self.tiles_x, tile as u32 / self.tiles_x);
-        let (x, y) = (tx * TILE + lane as u32 % TILE, ty * TILE + lane as u32 / TILE);
+        let (x, y) = (
+            tx * TILE + lane as u32 % TILE,
+            ty * TILE + lane as u32 / TILE,
+        );
         (x < self.width && y < self.height).then_some((x, y))
     }
 
@@ -47,12 +54,20 @@ pub struct Film {
 impl Film {
     pub fn new(width: u32, height: u32) -> Self {
         let layout = TileLayout::new(width, height);
-        Film { layout, sum: vec![[0.0; 3]; layout.tile_count() * 16], spp: 0 }
+        Film {
+            layout,
+            sum: vec![[0.0; 3]; layout.tile_count() * 16],
+            spp: 0,
+        }
     }
 
     /// The mean image in scan-line order.
     pub fn mean(&self) -> Image {
-        let inv = if self.spp == 0 { 0.0 } else { 1.0 / self.spp as f64 };
+        let inv = if self.spp == 0 {
+            0.0
+        } else {
+            1.0 / self.spp as f64
+        };
         let TileLayout { width, height, .. } = self.layout;
         let mut pixels = Vec::with_capacity((width * height) as usize);
         for y in 0..height {
@@ -61,7 +76,11 @@ impl Film {
                 pixels.push([s[0] * inv, s[1] * inv, s[2] * inv]);
             }
         }
-        Image { width, height, pixels }
+        Image {
+            width,
+            height,
+            pixels,
+        }
     }
 }
 

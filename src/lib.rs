@@ -6,6 +6,7 @@
 
 pub mod bsdf;
 pub mod cli;
+pub mod closed_form;
 pub mod error;
 pub mod film;
 pub mod geometry;
@@ -18,5 +19,6 @@ pub mod prepare;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod stats;
 pub mod strategy;
 pub mod tracer;

@@ -43,9 +43,17 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
     let mut out = [0.0f32; 3];
     for k in 0..3 {
         let bits = pa[k].to_bits() as i32;
-        let moved = if pa[k] < 0.0 { bits - of_i[k] } else { bits + of_i[k] };
+        let moved = if pa[k] < 0.0 {
+            bits - of_i[k]
+        } else {
+            bits + of_i[k]
+        };
         let p_i = f32::from_bits(moved as u32);
-        out[k] = if pa[k].abs() < ORIGIN { pa[k] + FLOAT_SCALE * n.to_array()[k] } else { p_i };
+        out[k] = if pa[k].abs() < ORIGIN {
+            pa[k] + FLOAT_SCALE * n.to_array()[k]
+        } else {
+            p_i
+        };
     }
     Vec3::from_array(out)
 }
@@ -78,7 +86,9 @@ mod tests {
         ] {
             let f = Frame::from_normal(n);
             assert!((f.s.length() - 1.0).abs() < 1e-5 && (f.t.length() - 1.0).abs() < 1e-5);
-            assert!(f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5
+            );
             let v = Vec3::new(0.2, -0.7, 0.4);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
         }
@@ -90,7 +100,10 @@ mod tests {
             let p = Vec3::new(scale, -scale, 0.5 * scale);
             let n = Vec3::new(0.3, -0.2, 0.9).normalize();
             let q = offset_ray_origin(p, n);
-            assert!((q - p).dot(n) > 0.0, "scale {scale}: offset not on the normal side");
+            assert!(
+                (q - p).dot(n) > 0.0,
+                "scale {scale}: offset not on the normal side"
+            );
         }
     }
 }

@@ -24,7 +24,11 @@ pub fn relmse(img: &Image, reference: &Image) -> f64 {
         .pixels
         .iter()
         .zip(&reference.pixels)
-        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + EPS)).sum::<f64>())
+        .map(|(a, b)| {
+            (0..3)
+                .map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + EPS))
+                .sum::<f64>()
+        })
         .sum();
     s / n
 }
@@ -35,8 +39,16 @@ mod tests {
 
     #[test]
     fn known_values() {
-        let r = Image { width: 2, height: 1, pixels: vec![[1.0; 3], [0.0; 3]] };
-        let a = Image { width: 2, height: 1, pixels: vec![[1.0; 3], [2.0; 3]] };
+        let r = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![[1.0; 3], [0.0; 3]],
+        };
+        let a = Image {
+            width: 2,
+            height: 1,
+            pixels: vec![[1.0; 3], [2.0; 3]],
+        };
         assert!((rmse(&a, &r) - 2.0f64.sqrt()).abs() < 1e-12);
         assert!((relmse(&a, &r) - 0.5 * 4.0 / 0.01).abs() < 1e-9);
         assert_eq!(rmse(&r, &r), 0.0);

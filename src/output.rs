@@ -14,7 +14,8 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
     let mut tmp = path.as_os_str().to_owned();
     tmp.push(format!(".tmp-{}", std::process::id()));
     let tmp = PathBuf::from(tmp);
-    let result = write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
+    let result =
+        write(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(|e| Error::io(path, e)));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
@@ -22,20 +23,31 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
 }
 
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_atomic(path, |tmp| std::fs::write(tmp, bytes).map_err(|e| Error::io(path, e)))
+    write_atomic(path, |tmp| {
+        std::fs::write(tmp, bytes).map_err(|e| Error::io(path, e))
+    })
 }
 
 pub fn write_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
-    let text = serde_json::to_string_pretty(value).map_err(|e| Error::Output { path: path.into(), message: e.to_string() })?;
+    let text = serde_json::to_string_pretty(value).map_err(|e| Error::Output {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
     write_bytes(path, format!("{text}\n").as_bytes())
 }
 
 pub fn write_csv<T: Serialize>(path: &Path, rows: &[T]) -> Result<()> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
-        w.serialize(r).map_err(|e| Error::Output { path: path.into(), message: e.to_string() })?;
+        w.serialize(r).map_err(|e| Error::Output {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
     }
-    let bytes = w.into_inner().map_err(|e| Error::Output { path: path.into(), message: e.to_string() })?;
+    let bytes = w.into_inner().map_err(|e| Error::Output {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
     write_bytes(path, &bytes)
 }
 
@@ -44,7 +56,11 @@ pub fn write_exr(path: &Path, img: &RgbImage) -> Result<()> {
     use exr::prelude::*;
     write_atomic(path, |tmp| {
         let w = img.width as usize;
-        let enc = Encoding { compression: Compression::ZIP16, blocks: Blocks::ScanLines, line_order: LineOrder::Increasing };
+        let enc = Encoding {
+            compression: Compression::ZIP16,
+            blocks: Blocks::ScanLines,
+            line_order: LineOrder::Increasing,
+        };
         let layer = Layer::new(
             (w, img.height as usize),
             LayerAttributes::default(),
@@ -57,7 +73,10 @@ pub fn write_exr(path: &Path, img: &RgbImage) -> Result<()> {
         exr::image::Image::from_layer(layer)
             .write()
             .to_file(tmp)
-            .map_err(|e| crate::error::Error::Output { path: path.into(), message: format!("cannot write EXR: {e}") })
+            .map_err(|e| crate::error::Error::Output {
+                path: path.into(),
+                message: format!("cannot write EXR: {e}"),
+            })
     })
 }
 
@@ -71,10 +90,17 @@ pub fn read_exr(path: &Path) -> Result<RgbImage> {
             px[pos.y() * *w + pos.x()] = [r as f64, g as f64, b as f64];
         },
     )
-    .map_err(|e| crate::error::Error::Parse { path: path.into(), message: format!("not a readable EXR image: {e}") })?;
+    .map_err(|e| crate::error::Error::Parse {
+        path: path.into(),
+        message: format!("not a readable EXR image: {e}"),
+    })?;
     let size = image.layer_data.size;
     let (_, pixels) = image.layer_data.channel_data.pixels;
-    Ok(RgbImage { width: size.width() as u32, height: size.height() as u32, pixels })
+    Ok(RgbImage {
+        width: size.width() as u32,
+        height: size.height() as u32,
+        pixels,
+    })
 }
 
 #[cfg(test)]
@@ -82,14 +108,28 @@ mod tests {
     use super::*;
 
     #[test]
-    fn exr_round_trip_is_exact_in_f32() {
+    fn exr_round_trip_is_exact_for_f32_values() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("a.exr");
-        let img = RgbImage { width: 3, height: 2, pixels: (0..6).map(|i| [i as f64 * 0.25, 1e-3, 7.5e3]).collect() };
+        let img = RgbImage {
+            width: 3,
+            height: 2,
+            pixels: (0..6)
+                .map(|i| [i as f64 * 0.25, 0.0009765625, 7.5e3])
+                .collect(),
+        };
         write_exr(&path, &img).unwrap();
         assert_eq!(read_exr(&path).unwrap(), img);
-        let leftovers: Vec<_> = std::fs::read_dir(dir.path()).unwrap().flatten().map(|e| e.file_name()).collect();
-        assert_eq!(leftovers.len(), 1, "temporary files left behind: {leftovers:?}");
+        let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        assert_eq!(
+            leftovers.len(),
+            1,
+            "temporary files left behind: {leftovers:?}"
+        );
     }
 
     #[test]

@@ -50,7 +50,10 @@ impl PreparedScene {
     }
 
     /// Prepares with a tracer of the caller's choice (a backend built over the same geometry).
-    pub fn with_tracer(scene: Scene, make_tracer: impl FnOnce(Arc<Geometry>) -> Box<dyn Tracer>) -> Self {
+    pub fn with_tracer(
+        scene: Scene,
+        make_tracer: impl FnOnce(Arc<Geometry>) -> Box<dyn Tracer>,
+    ) -> Self {
         let mut g = Geometry::default();
         let mut prim_material = Vec::new();
         let mut prim_emitter = Vec::new();
@@ -60,16 +63,28 @@ impl PreparedScene {
             let tris: Vec<Triangle> = mesh
                 .triangles
                 .iter()
-                .map(|t| Triangle::new(mesh.positions[t[0] as usize], mesh.positions[t[1] as usize], mesh.positions[t[2] as usize]))
+                .map(|t| {
+                    Triangle::new(
+                        mesh.positions[t[0] as usize],
+                        mesh.positions[t[1] as usize],
+                        mesh.positions[t[2] as usize],
+                    )
+                })
                 .collect();
-            let light = mesh.emission.and_then(|l| MeshLight::new(tris.clone(), l)).map(|m| {
-                lights.push(Light::Mesh(m));
-                lights.len() as u32 - 1
-            });
+            let light = mesh
+                .emission
+                .and_then(|l| MeshLight::new(tris.clone(), l))
+                .map(|m| {
+                    lights.push(Light::Mesh(m));
+                    lights.len() as u32 - 1
+                });
             for (k, t) in tris.into_iter().enumerate() {
                 g.triangles.push(t);
                 prim_material.push(mesh.material);
-                prim_emitter.push(light.map(|light| EmitterRef { light, local: k as u32 }));
+                prim_emitter.push(light.map(|light| EmitterRef {
+                    light,
+                    local: k as u32,
+                }));
             }
         }
         for q in &scene.quads {
@@ -79,7 +94,10 @@ impl PreparedScene {
             });
             let (c, u, v) = (q.corner, q.edge_u, q.edge_v);
             // Both triangles keep the winding of edge_u × edge_v.
-            for t in [Triangle::new(c, c + u, c + u + v), Triangle::new(c, c + u + v, c + v)] {
+            for t in [
+                Triangle::new(c, c + u, c + u + v),
+                Triangle::new(c, c + u + v, c + v),
+            ] {
                 g.triangles.push(t);
                 prim_material.push(q.material);
                 prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
@@ -87,15 +105,25 @@ impl PreparedScene {
         }
         for s in &scene.spheres {
             let light = s.emission.map(|l| {
-                lights.push(Light::Sphere(SphereLight { center: s.center, radius: s.radius, radiance: l }));
+                lights.push(Light::Sphere(SphereLight {
+                    center: s.center,
+                    radius: s.radius,
+                    radiance: l,
+                }));
                 lights.len() as u32 - 1
             });
-            g.spheres.push(Sphere { center: s.center, radius: s.radius });
+            g.spheres.push(Sphere {
+                center: s.center,
+                radius: s.radius,
+            });
             prim_material.push(s.material);
             prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
         }
         for p in &scene.point_lights {
-            lights.push(Light::Point(PointLight { position: p.position, intensity: p.intensity }));
+            lights.push(Light::Point(PointLight {
+                position: p.position,
+                intensity: p.intensity,
+            }));
         }
 
         let light_selection = if lights.is_empty() {
@@ -105,7 +133,15 @@ impl PreparedScene {
         };
         let geometry = Arc::new(g);
         let tracer = make_tracer(geometry.clone());
-        PreparedScene { scene, geometry, tracer, prim_material, prim_emitter, lights, light_selection }
+        PreparedScene {
+            scene,
+            geometry,
+            tracer,
+            prim_material,
+            prim_emitter,
+            lights,
+            light_selection,
+        }
     }
 
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
@@ -121,7 +157,12 @@ impl PreparedScene {
                 (p, s.normal_at(p))
             }
         };
-        SurfaceHit { p, ng, material: self.prim_material[hit.prim as usize], emitter: self.prim_emitter[hit.prim as usize] }
+        SurfaceHit {
+            p,
+            ng,
+            material: self.prim_material[hit.prim as usize],
+            emitter: self.prim_emitter[hit.prim as usize],
+        }
     }
 
     /// Radiance an emitter primitive sends back along a ray that hit it.
@@ -132,9 +173,22 @@ impl PreparedScene {
         }
     }
 
+    /// Radiance arriving back along `ray` from what it hit.
+    pub fn emitted_at(&self, ray: &Ray, hit: &Hit) -> Vec3 {
+        if self.prim_emitter[hit.prim as usize].is_none() {
+            return Vec3::ZERO;
+        }
+        self.emitted(&self.surface(ray, hit), ray.dir)
+    }
+
     /// Picks a light by power and samples it with its default sampler; the returned pdf
     /// includes the selection probability.
-    pub fn sample_light(&self, p: Vec3, u_select: f32, u: [f32; 3]) -> Option<(usize, LightSample)> {
+    pub fn sample_light(
+        &self,
+        p: Vec3,
+        u_select: f32,
+        u: [f32; 3],
+    ) -> Option<(usize, LightSample)> {
         let sel = self.light_selection.as_ref()?;
         let i = sel.sample(u_select);
         let mut s = self.lights[i].sample(p, u)?;

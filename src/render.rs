@@ -3,7 +3,6 @@
 
 use crate::film::{Film, TileLayout};
 use crate::geometry::Ray;
-use crate::math::offset_ray_origin;
 use crate::prepare::PreparedScene;
 use crate::sampling::stream::{SampleStream, name_id};
 use crate::scene::Camera;
@@ -21,7 +20,12 @@ pub struct Renderer<'a> {
 
 impl<'a> Renderer<'a> {
     pub fn new(scene: &'a PreparedScene, strategy: &'a dyn Strategy, seed: u64) -> Self {
-        Renderer { scene, strategy, seed, strategy_id: name_id(strategy.name()) }
+        Renderer {
+            scene,
+            strategy,
+            seed,
+            strategy_id: name_id(strategy.name()),
+        }
     }
 
     /// Adds one sample per pixel to the film; pass `film.spp` numbers the random streams, so
@@ -29,14 +33,17 @@ impl<'a> Renderer<'a> {
     pub fn add_pass(&self, film: &mut Film) {
         let pass = film.spp;
         let layout = film.layout;
-        film.sum.par_chunks_mut(16).enumerate().for_each(|(tile, out)| {
-            let radiance = self.render_tile(&layout, tile, pass);
-            for (o, l) in out.iter_mut().zip(radiance.iter()) {
-                o[0] += l.x as f64;
-                o[1] += l.y as f64;
-                o[2] += l.z as f64;
-            }
-        });
+        film.sum
+            .par_chunks_mut(16)
+            .enumerate()
+            .for_each(|(tile, out)| {
+                let radiance = self.render_tile(&layout, tile, pass);
+                for (o, l) in out.iter_mut().zip(radiance.iter()) {
+                    o[0] += l.x as f64;
+                    o[1] += l.y as f64;
+                    o[2] += l.z as f64;
+                }
+            });
         film.spp += 1;
     }
 
@@ -48,13 +55,13 @@ impl<'a> Renderer<'a> {
         let mut rngs: [Option<SampleStream>; LANES] = Default::default();
         let mut cam = RayPacket::default();
         let mut active: LaneMask = 0;
-        for lane in 0..LANES {
+        for (lane, slot) in rngs.iter_mut().enumerate() {
             if let Some((x, y)) = shape.lane_pixel(tile, lane) {
                 let pixel = y as u64 * w as u64 + x as u64;
                 let mut rng = SampleStream::new(self.seed, self.strategy_id, pixel, pass);
                 let ray = camera_ray(camera, w, h, x, y, rng.next_2d());
                 cam.set(lane, &ray);
-                rngs[lane] = Some(rng);
+                *slot = Some(rng);
                 active |= 1 << lane;
             }
         }
@@ -68,17 +75,18 @@ impl<'a> Renderer<'a> {
         let mut emit_weight = [Vec3::ZERO; LANES];
         let mut emit_mask: LaneMask = 0;
         for lane in 0..LANES {
-            let (Some(hit), Some(rng)) = (hits.get(lane), rngs[lane].as_mut()) else { continue };
+            let (Some(hit), Some(rng)) = (hits.get(lane), rngs[lane].as_mut()) else {
+                continue;
+            };
             let ray = cam.get(lane);
             let surf = scene.surface(&ray, &hit);
             radiance[lane] += scene.emitted(&surf, ray.dir);
-            let n = if surf.ng.dot(ray.dir) < 0.0 { surf.ng } else { -surf.ng };
-            let sp = ShadingPoint {
-                p: surf.p,
-                origin: offset_ray_origin(surf.p, n),
-                n,
-                albedo: scene.scene.materials[surf.material as usize].albedo,
-            };
+            let sp = ShadingPoint::new(
+                surf.p,
+                surf.ng,
+                ray.dir,
+                scene.scene.materials[surf.material as usize].albedo,
+            );
             let probes = self.strategy.sample(scene, &sp, rng);
             if let Some(s) = probes.shadow {
                 shadow.set(lane, &s.ray);
@@ -104,9 +112,7 @@ impl<'a> Renderer<'a> {
             scene.tracer.intersect_packet(&emit, emit_mask, &mut ehits);
             for lane in 0..LANES {
                 if let Some(hit) = ehits.get(lane) {
-                    let ray = emit.get(lane);
-                    let surf = scene.surface(&ray, &hit);
-                    radiance[lane] += emit_weight[lane] * scene.emitted(&surf, ray.dir);
+                    radiance[lane] += emit_weight[lane] * scene.emitted_at(&emit.get(lane), &hit);
                 }
             }
         }
@@ -119,5 +125,9 @@ pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ra
     let aspect = w as f32 / h as f32;
     let sx = (2.0 * (x as f32 + u[0]) / w as f32 - 1.0) * aspect * c.tan_half_fov_y;
     let sy = (1.0 - 2.0 * (y as f32 + u[1]) / h as f32) * c.tan_half_fov_y;
-    Ray::new(c.eye, (c.forward + c.right * sx + c.up * sy).normalize(), f32::INFINITY)
+    Ray::new(
+        c.eye,
+        (c.forward + c.right * sx + c.up * sy).normalize(),
+        f32::INFINITY,
+    )
 }

@@ -59,7 +59,10 @@ mod tests {
 
     #[test]
     fn outside_inside_and_far_small_spheres() {
-        let s = Sphere { center: Vec3::new(0.0, 0.0, -5.0), radius: 1.0 };
+        let s = Sphere {
+            center: Vec3::new(0.0, 0.0, -5.0),
+            radius: 1.0,
+        };
         let ray = Ray::new(Vec3::ZERO, -Vec3::Z, f32::INFINITY);
         assert!((s.intersect(&ray).unwrap() - 4.0).abs() < 1e-5);
         let inside = Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::X, f32::INFINITY);
@@ -67,7 +70,10 @@ mod tests {
         let behind = Ray::new(Vec3::ZERO, Vec3::Z, f32::INFINITY);
         assert!(s.intersect(&behind).is_none());
         // A 1e-3 sphere at distance 1e4: the textbook quadratic loses it entirely in f32.
-        let tiny = Sphere { center: Vec3::new(0.0, 0.0, -1e4), radius: 1e-3 };
+        let tiny = Sphere {
+            center: Vec3::new(0.0, 0.0, -1e4),
+            radius: 1e-3,
+        };
         let t = tiny.intersect(&ray).expect("tiny far sphere must be hit");
         assert!((t - (1e4 - 1e-3)).abs() / 1e4 < 1e-6);
     }

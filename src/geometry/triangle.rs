@@ -27,7 +27,13 @@ pub struct WatertightRay {
 impl WatertightRay {
     pub fn new(dir: Vec3) -> Self {
         let a = dir.abs().to_array();
-        let kz = if a[0] > a[1] { if a[0] > a[2] { 0 } else { 2 } } else if a[1] > a[2] { 1 } else { 2 };
+        let kz = if a[0] > a[1] {
+            if a[0] > a[2] { 0 } else { 2 }
+        } else if a[1] > a[2] {
+            1
+        } else {
+            2
+        };
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         let d = dir.to_array();
@@ -35,7 +41,14 @@ impl WatertightRay {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        WatertightRay { kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
+        WatertightRay {
+            kx,
+            ky,
+            kz,
+            sx: d[kx] / d[kz],
+            sy: d[ky] / d[kz],
+            sz: 1.0 / d[kz],
+        }
     }
 }
 
@@ -68,7 +81,11 @@ impl Triangle {
     /// Two-sided intersection in (0, ray.tmax).
     pub fn intersect(&self, ray: &Ray, wr: &WatertightRay) -> Option<TriangleHit> {
         let o = ray.origin;
-        let (a, b, c) = ((self.v0 - o).to_array(), (self.v1 - o).to_array(), (self.v2 - o).to_array());
+        let (a, b, c) = (
+            (self.v0 - o).to_array(),
+            (self.v1 - o).to_array(),
+            (self.v2 - o).to_array(),
+        );
         let (kx, ky, kz) = (wr.kx, wr.ky, wr.kz);
         let ax = a[kx] - wr.sx * a[kz];
         let ay = a[ky] - wr.sy * a[kz];
@@ -104,7 +121,11 @@ impl Triangle {
             return None;
         }
         let inv = 1.0 / det;
-        Some(TriangleHit { t: t_scaled * inv, b1: v * inv, b2: w * inv })
+        Some(TriangleHit {
+            t: t_scaled * inv,
+            b1: v * inv,
+            b2: w * inv,
+        })
     }
 }
 
@@ -114,15 +135,35 @@ mod tests {
 
     #[test]
     fn hits_inside_and_misses_outside() {
-        let tri = Triangle::new(Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, 1.0, 0.0));
-        let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0), f32::INFINITY);
-        let h = tri.intersect(&ray, &WatertightRay::new(ray.dir)).expect("hit");
+        let tri = Triangle::new(
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        let ray = Ray::new(
+            Vec3::new(0.25, 0.25, 1.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            f32::INFINITY,
+        );
+        let h = tri
+            .intersect(&ray, &WatertightRay::new(ray.dir))
+            .expect("hit");
         assert!((h.t - 1.0).abs() < 1e-6);
         assert!((tri.point(h.b1, h.b2) - Vec3::new(0.25, 0.25, 0.0)).length() < 1e-6);
-        let miss = Ray::new(Vec3::new(0.75, 0.75, 1.0), Vec3::new(0.0, 0.0, -1.0), f32::INFINITY);
-        assert!(tri.intersect(&miss, &WatertightRay::new(miss.dir)).is_none());
+        let miss = Ray::new(
+            Vec3::new(0.75, 0.75, 1.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            f32::INFINITY,
+        );
+        assert!(
+            tri.intersect(&miss, &WatertightRay::new(miss.dir))
+                .is_none()
+        );
         let short = Ray::new(ray.origin, ray.dir, 0.5);
-        assert!(tri.intersect(&short, &WatertightRay::new(short.dir)).is_none());
+        assert!(
+            tri.intersect(&short, &WatertightRay::new(short.dir))
+                .is_none()
+        );
     }
 
     /// Rays through the shared diagonal of a two-triangle quad must hit at least one triangle

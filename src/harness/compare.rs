@@ -9,7 +9,7 @@ use crate::metrics::{relmse, rmse};
 use crate::output::{write_csv, write_exr, write_json};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
-use crate::strategy::Strategy;
+use crate::strategy::{Skipped, Strategy};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -49,7 +49,7 @@ struct RunMeta<'a> {
     seed: u64,
     budget_s: f64,
     strategies: Vec<&'a str>,
-    skipped: &'a [(String, String)],
+    skipped: &'a [Skipped],
     reference_spp: u64,
     dibench_version: &'a str,
     commit: &'a str,
@@ -57,7 +57,13 @@ struct RunMeta<'a> {
 
 /// One strategy's equal-time run: passes until the budget is spent, rows at checkpoints.
 /// Time spent measuring the error is excluded from the clock.
-pub fn run_strategy(scene: &PreparedScene, strategy: &dyn Strategy, reference: &Image, opts: &CompareOptions, mut on_progress: impl FnMut(Duration)) -> (Image, Vec<ResultRow>) {
+pub fn run_strategy(
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    reference: &Image,
+    opts: &CompareOptions,
+    mut on_progress: impl FnMut(Duration),
+) -> (Image, Vec<ResultRow>) {
     let renderer = Renderer::new(scene, strategy, opts.seed);
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let budget = Duration::from_secs_f64(opts.time_s);
@@ -96,21 +102,39 @@ pub fn run_strategy(scene: &PreparedScene, strategy: &dyn Strategy, reference: &
 pub struct CompareReport {
     pub run_dir: PathBuf,
     pub rows: Vec<ResultRow>,
-    pub skipped: Vec<(String, String)>,
+    pub skipped: Vec<Skipped>,
 }
 
 /// Runs `strategies` at equal time and writes `<out>/<scene>/<run-id>/`: one EXR per strategy,
 /// `results.csv` (rewritten after each strategy, so an interrupted run keeps what finished)
 /// and `run.json`.
-pub fn run(scene: &PreparedScene, strategies: &[Box<dyn Strategy>], skipped: Vec<(String, String)>, reference: &Image, reference_spp: u64, out: &Path, opts: &CompareOptions) -> Result<CompareReport> {
+pub fn run(
+    scene: &PreparedScene,
+    strategies: &[Box<dyn Strategy>],
+    skipped: Vec<Skipped>,
+    reference: &Image,
+    reference_spp: u64,
+    out: &Path,
+    opts: &CompareOptions,
+) -> Result<CompareReport> {
     if !(opts.time_s.is_finite() && opts.time_s > 0.0) {
-        return Err(Error::Usage(format!("--time must be a positive number of seconds, got {}", opts.time_s)));
+        return Err(Error::Usage(format!(
+            "--time must be a positive number of seconds, got {}",
+            opts.time_s
+        )));
     }
     if strategies.is_empty() {
-        return Err(Error::Usage(format!("scene `{}`: no strategy applies", scene.scene.name)));
+        return Err(Error::Usage(format!(
+            "scene `{}`: no strategy applies",
+            scene.scene.name
+        )));
     }
-    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string().replace(':', "-");
-    let run_dir = out.join(&scene.scene.name).join(format!("{stamp}-seed{}", opts.seed));
+    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())
+        .to_string()
+        .replace(':', "-");
+    let run_dir = out
+        .join(&scene.scene.name)
+        .join(format!("{stamp}-seed{}", opts.seed));
     let meta = RunMeta {
         scene: &scene.scene.name,
         scene_hash: &scene.scene.content_hash,
@@ -130,7 +154,11 @@ pub fn run(scene: &PreparedScene, strategies: &[Box<dyn Strategy>], skipped: Vec
     let mut rows = Vec::new();
     let budget_ms = (opts.time_s * 1000.0).ceil() as u64;
     for s in strategies {
-        let bar = progress_bar(budget_ms, format!("{:<10}", s.name()), "{prefix} [{bar:30}] {msg}");
+        let bar = progress_bar(
+            budget_ms,
+            format!("{:<10}", s.name()),
+            "{prefix} [{bar:30}] {msg}",
+        );
         let (image, mut r) = run_strategy(scene, s.as_ref(), reference, opts, |t| {
             bar.set_position(t.as_millis() as u64);
         });
@@ -139,5 +167,9 @@ pub fn run(scene: &PreparedScene, strategies: &[Box<dyn Strategy>], skipped: Vec
         rows.append(&mut r);
         write_csv(&run_dir.join("results.csv"), &rows)?;
     }
-    Ok(CompareReport { run_dir, rows, skipped })
+    Ok(CompareReport {
+        run_dir,
+        rows,
+        skipped,
+    })
 }

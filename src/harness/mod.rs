@@ -11,7 +11,13 @@ pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 pub const COMMIT: &str = env!("DIBENCH_COMMIT");
 
 /// Renders `spp` passes with a renderer; the single place where whole images are made.
-pub fn render_spp(renderer: &Renderer, width: u32, height: u32, spp: u64, mut on_pass: impl FnMut(u64)) -> Image {
+pub fn render_spp(
+    renderer: &Renderer,
+    width: u32,
+    height: u32,
+    spp: u64,
+    mut on_pass: impl FnMut(u64),
+) -> Image {
     let mut film = Film::new(width, height);
     for _ in 0..spp {
         renderer.add_pass(&mut film);

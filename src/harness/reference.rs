@@ -40,18 +40,36 @@ fn reference_stream_seed(seed: u64) -> u64 {
     mix64(seed) ^ 0x5245_4645_5245_4e43
 }
 
-pub fn render(scene: &PreparedScene, spp: u64, seed: u64, threads: usize) -> Result<(Image, ReferenceMeta)> {
+pub fn render(
+    scene: &PreparedScene,
+    spp: u64,
+    seed: u64,
+    threads: usize,
+) -> Result<(Image, ReferenceMeta)> {
     if spp == 0 {
         return Err(Error::Usage("--spp must be at least 1".into()));
     }
     let strategy = reference_strategy();
-    strategy
-        .applies(scene)
-        .map_err(|why| Error::Usage(format!("scene `{}`: cannot render a reference: {why}", scene.scene.name)))?;
+    strategy.applies(scene).map_err(|why| {
+        Error::Usage(format!(
+            "scene `{}`: cannot render a reference: {why}",
+            scene.scene.name
+        ))
+    })?;
     let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
-    let bar = progress_bar(spp, format!("reference {}", scene.scene.name), "{prefix} [{bar:30}] {pos}/{len} spp, eta {eta}");
+    let bar = progress_bar(
+        spp,
+        format!("reference {}", scene.scene.name),
+        "{prefix} [{bar:30}] {pos}/{len} spp, eta {eta}",
+    );
     let start = Instant::now();
-    let image = render_spp(&renderer, scene.scene.width, scene.scene.height, spp, |_| bar.inc(1));
+    let image = render_spp(
+        &renderer,
+        scene.scene.width,
+        scene.scene.height,
+        spp,
+        |_| bar.inc(1),
+    );
     bar.finish_and_clear();
     let meta = ReferenceMeta {
         scene: scene.scene.name.clone(),
@@ -79,12 +97,25 @@ pub fn save(out: &Path, image: &Image, meta: &ReferenceMeta) -> Result<PathBuf> 
 }
 
 /// A stored reference for exactly this scene content and resolution with at least `min_spp`.
-pub fn load_matching(out: &Path, scene: &PreparedScene, min_spp: u64) -> Result<Option<(Image, ReferenceMeta)>> {
+pub fn load_matching(
+    out: &Path,
+    scene: &PreparedScene,
+    min_spp: u64,
+) -> Result<Option<(Image, ReferenceMeta)>> {
     let dir = reference_dir(out, &scene.scene.name);
     let json = dir.join("reference.json");
-    let Ok(text) = std::fs::read_to_string(&json) else { return Ok(None) };
-    let meta: ReferenceMeta = serde_json::from_str(&text).map_err(|e| Error::Parse { path: json.clone(), message: e.to_string() })?;
-    if meta.scene_hash != scene.scene.content_hash || meta.width != scene.scene.width || meta.height != scene.scene.height || meta.spp < min_spp {
+    let Ok(text) = std::fs::read_to_string(&json) else {
+        return Ok(None);
+    };
+    let meta: ReferenceMeta = serde_json::from_str(&text).map_err(|e| Error::Parse {
+        path: json.clone(),
+        message: e.to_string(),
+    })?;
+    if meta.scene_hash != scene.scene.content_hash
+        || meta.width != scene.scene.width
+        || meta.height != scene.scene.height
+        || meta.spp < min_spp
+    {
         return Ok(None);
     }
     let image = read_exr(&dir.join("reference.exr"))?;

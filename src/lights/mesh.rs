@@ -24,8 +24,17 @@ impl MeshLight {
     pub fn new(triangles: Vec<Triangle>, radiance: Vec3) -> Option<Self> {
         let areas: Vec<f32> = triangles.iter().map(Triangle::area).collect();
         let by_area = DiscreteDistribution::new(&areas)?;
-        let normals = triangles.iter().map(|t| t.cross().normalize_or_zero()).collect();
-        Some(MeshLight { area: by_area.total() as f32, triangles, normals, by_area, radiance })
+        let normals = triangles
+            .iter()
+            .map(|t| t.cross().normalize_or_zero())
+            .collect();
+        Some(MeshLight {
+            area: by_area.total() as f32,
+            triangles,
+            normals,
+            by_area,
+            radiance,
+        })
     }
 
     pub fn power(&self) -> f32 {
@@ -42,10 +51,16 @@ impl MeshLight {
         let d2 = d.length_squared();
         let wi = d / d2.sqrt();
         let cos_l = -n.dot(wi);
-        if !(cos_l > 0.0) {
+        if cos_l <= 0.0 {
             return None;
         }
-        Some(LightSample { wi, point: q, normal: n, radiance: self.radiance, pdf: d2 / (self.area * cos_l) })
+        Some(LightSample {
+            wi,
+            point: q,
+            normal: n,
+            radiance: self.radiance,
+            pdf: d2 / (self.area * cos_l),
+        })
     }
 
     /// Solid-angle pdf of [`Self::sample_area`] for the direction reaching point q on triangle i.
@@ -53,7 +68,11 @@ impl MeshLight {
         let d = q - p;
         let d2 = d.length_squared();
         let cos_l = -self.normals[i].dot(d) / d2.sqrt();
-        if cos_l > 0.0 { d2 / (self.area * cos_l) } else { 0.0 }
+        if cos_l > 0.0 {
+            d2 / (self.area * cos_l)
+        } else {
+            0.0
+        }
     }
 }
 

@@ -30,7 +30,11 @@ impl LightSample {
     /// The unoccluded-test segment from a shading point (already offset) to the sample, with the
     /// light end offset off the light's own surface so the light does not shadow itself.
     pub fn shadow_ray(&self, origin: Vec3) -> Option<Ray> {
-        let target = if self.normal == Vec3::ZERO { self.point } else { offset_ray_origin(self.point, self.normal) };
+        let target = if self.normal == Vec3::ZERO {
+            self.point
+        } else {
+            offset_ray_origin(self.point, self.normal)
+        };
         let d = target - origin;
         let dist = d.length();
         if dist == 0.0 {
@@ -81,8 +85,20 @@ impl Light {
     pub fn emitted(&self, n: Vec3, w: Vec3) -> Vec3 {
         match self {
             Light::Point(_) => Vec3::ZERO,
-            Light::Quad(l) => if n.dot(w) > 0.0 { l.radiance } else { Vec3::ZERO },
-            Light::Mesh(l) => if n.dot(w) > 0.0 { l.radiance } else { Vec3::ZERO },
+            Light::Quad(l) => {
+                if n.dot(w) > 0.0 {
+                    l.radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
+            Light::Mesh(l) => {
+                if n.dot(w) > 0.0 {
+                    l.radiance
+                } else {
+                    Vec3::ZERO
+                }
+            }
             Light::Sphere(l) => l.radiance,
         }
     }

@@ -24,6 +24,12 @@ impl PointLight {
             return None;
         }
         let wi = d / d2.sqrt();
-        Some(LightSample { wi, point: self.position, normal: Vec3::ZERO, radiance: self.intensity / d2, pdf: 1.0 })
+        Some(LightSample {
+            wi,
+            point: self.position,
+            normal: Vec3::ZERO,
+            radiance: self.intensity / d2,
+            pdf: 1.0,
+        })
     }
 }

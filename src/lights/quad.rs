@@ -21,7 +21,14 @@ impl QuadLight {
     pub fn new(corner: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: Vec3) -> Self {
         let c = edge_u.cross(edge_v);
         let area = c.length();
-        QuadLight { corner, edge_u, edge_v, normal: c / area, area, radiance }
+        QuadLight {
+            corner,
+            edge_u,
+            edge_v,
+            normal: c / area,
+            area,
+            radiance,
+        }
     }
 
     pub fn power(&self) -> f32 {
@@ -36,10 +43,16 @@ impl QuadLight {
         let d2 = d.length_squared();
         let wi = d / d2.sqrt();
         let cos_l = -self.normal.dot(wi);
-        if !(cos_l > 0.0) {
+        if cos_l <= 0.0 {
             return None;
         }
-        Some(LightSample { wi, point: q, normal: self.normal, radiance: self.radiance, pdf: d2 / (self.area * cos_l) })
+        Some(LightSample {
+            wi,
+            point: q,
+            normal: self.normal,
+            radiance: self.radiance,
+            pdf: d2 / (self.area * cos_l),
+        })
     }
 
     /// Solid-angle pdf of [`Self::sample_area`] for the direction that reaches light point q.
@@ -47,6 +60,10 @@ impl QuadLight {
         let d = q - p;
         let d2 = d.length_squared();
         let cos_l = -self.normal.dot(d) / d2.sqrt();
-        if cos_l > 0.0 { d2 / (self.area * cos_l) } else { 0.0 }
+        if cos_l > 0.0 {
+            d2 / (self.area * cos_l)
+        } else {
+            0.0
+        }
     }
 }

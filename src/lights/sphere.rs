@@ -6,7 +6,10 @@
 
 use super::LightSample;
 use crate::math::{Frame, luminance};
-use crate::sampling::warp::{UNIFORM_SPHERE_PDF, one_minus_cos_from_sin2, sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf};
+use crate::sampling::warp::{
+    UNIFORM_SPHERE_PDF, one_minus_cos_from_sin2, sample_uniform_cone, sample_uniform_sphere,
+    uniform_cone_pdf,
+};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -44,11 +47,21 @@ impl SphereLight {
         let cos_a = sin2_t / sin_max + cos_t * (1.0 - sin2_t / sin2_max).max(0.0).sqrt();
         let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
         let sin_t = sin2_t.sqrt();
-        let (cos_phi, sin_phi) = if sin_t > 0.0 { (local.x / sin_t, local.y / sin_t) } else { (1.0, 0.0) };
+        let (cos_phi, sin_phi) = if sin_t > 0.0 {
+            (local.x / sin_t, local.y / sin_t)
+        } else {
+            (1.0, 0.0)
+        };
         let normal = frame.to_world(Vec3::new(sin_a * cos_phi, sin_a * sin_phi, -cos_a));
         let point = self.center + normal * self.radius;
         let wi = (point - p).normalize();
-        Some(LightSample { wi, point, normal, radiance: self.radiance, pdf: uniform_cone_pdf(omc_max) })
+        Some(LightSample {
+            wi,
+            point,
+            normal,
+            radiance: self.radiance,
+            pdf: uniform_cone_pdf(omc_max),
+        })
     }
 
     /// Solid-angle pdf of [`Self::sample_cone`] for the direction from p to the light point q.
@@ -65,14 +78,22 @@ impl SphereLight {
         let wi = (q - p).normalize();
         let axis = to_c / d2.sqrt();
         let inside = wi.dot(axis) > 0.0 && wi.cross(axis).length_squared() <= sin2_max;
-        if inside { uniform_cone_pdf(one_minus_cos_from_sin2(sin2_max)) } else { 0.0 }
+        if inside {
+            uniform_cone_pdf(one_minus_cos_from_sin2(sin2_max))
+        } else {
+            0.0
+        }
     }
 
     fn pdf_area_inside(&self, p: Vec3, q: Vec3) -> f32 {
         let d = q - p;
         let dist2 = d.length_squared();
         let cos_l = ((q - self.center) / self.radius).dot(d).abs() / dist2.sqrt();
-        if cos_l > 0.0 { UNIFORM_SPHERE_PDF / (self.radius * self.radius) * dist2 / cos_l } else { 0.0 }
+        if cos_l > 0.0 {
+            UNIFORM_SPHERE_PDF / (self.radius * self.radius) * dist2 / cos_l
+        } else {
+            0.0
+        }
     }
 
     /// Uniform over the whole sphere's area, for points inside it, where every surface point
@@ -92,6 +113,12 @@ impl SphereLight {
         }
         let area_pdf = UNIFORM_SPHERE_PDF / (self.radius * self.radius);
         // Oriented towards p: from inside, that is the inward normal.
-        Some(LightSample { wi, point, normal: -n, radiance: self.radiance, pdf: area_pdf * dist2 / cos_l })
+        Some(LightSample {
+            wi,
+            point,
+            normal: -n,
+            radiance: self.radiance,
+            pdf: area_pdf * dist2 / cos_l,
+        })
     }
 }

@@ -26,7 +26,11 @@ impl DiscreteDistribution {
             return None;
         }
         let pmf = weights.iter().map(|&w| (w as f64 / acc) as f32).collect();
-        Some(DiscreteDistribution { cdf, pmf, total: acc })
+        Some(DiscreteDistribution {
+            cdf,
+            pmf,
+            total: acc,
+        })
     }
 
     pub fn len(&self) -> usize {

@@ -12,7 +12,9 @@ pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 impl SampleStream {
     pub fn new(seed: u64, strategy: u64, pixel: u64, pass: u64) -> Self {
-        let key = mix64(mix64(mix64(seed ^ mix64(strategy)) ^ pixel) ^ pass.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        let key = mix64(
+            mix64(mix64(seed ^ mix64(strategy)) ^ pixel) ^ pass.wrapping_mul(0x9E37_79B9_7F4A_7C15),
+        );
         SampleStream(Pcg32::seed_from_u64(key))
     }
 
@@ -29,5 +31,7 @@ impl SampleStream {
 /// A stable 64-bit id of a name (FNV-1a), so a strategy's random stream does not depend on its
 /// position in the registry.
 pub fn name_id(name: &str) -> u64 {
-    name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3))
+    name.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3)
+    })
 }

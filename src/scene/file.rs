@@ -82,7 +82,11 @@ fn one() -> f32 {
 
 impl Default for TransformDesc {
     fn default() -> Self {
-        TransformDesc { scale: 1.0, rotate_y_deg: 0.0, translate: [0.0; 3] }
+        TransformDesc {
+            scale: 1.0,
+            rotate_y_deg: 0.0,
+            translate: [0.0; 3],
+        }
     }
 }
 

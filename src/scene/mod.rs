@@ -99,15 +99,24 @@ impl Scene {
         if direct.is_file() {
             return Ok(direct);
         }
-        let file = if name_or_path.ends_with(".toml") { name_or_path.to_string() } else { format!("{name_or_path}.toml") };
-        for root in [PathBuf::from("scenes"), Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")] {
+        let file = if name_or_path.ends_with(".toml") {
+            name_or_path.to_string()
+        } else {
+            format!("{name_or_path}.toml")
+        };
+        for root in [
+            PathBuf::from("scenes"),
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"),
+        ] {
             let candidate = root.join(&file);
             if candidate.is_file() {
                 return Ok(candidate);
             }
         }
         let known = Self::builtin_names().join(", ");
-        Err(Error::Usage(format!("no scene file `{name_or_path}` and no scene of that name in scenes/ (known: {known})")))
+        Err(Error::Usage(format!(
+            "no scene file `{name_or_path}` and no scene of that name in scenes/ (known: {known})"
+        )))
     }
 
     /// The names of the scenes shipped in `scenes/`.
@@ -119,7 +128,11 @@ impl Scene {
             .flatten()
             .filter_map(|e| {
                 let p = e.path();
-                if p.extension()? == "toml" { Some(p.file_stem()?.to_string_lossy().into_owned()) } else { None }
+                if p.extension()? == "toml" {
+                    Some(p.file_stem()?.to_string_lossy().into_owned())
+                } else {
+                    None
+                }
             })
             .collect();
         names.sort();
@@ -128,16 +141,34 @@ impl Scene {
 
     pub fn load(path: &Path) -> Result<Scene> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let desc: SceneFile =
-            toml::from_str(&text).map_err(|e| Error::Parse { path: path.to_path_buf(), message: e.to_string() })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses scene text as if read from `path` (which names errors and anchors mesh files).
+    pub fn parse(text: &str, path: &Path) -> Result<Scene> {
+        let desc: SceneFile = toml::from_str(text).map_err(|e| Error::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
         let mut hasher = Sha256::new();
         hasher.update(text.as_bytes());
         let base = path.parent().unwrap_or(Path::new("."));
         let v = Validator { path };
 
         let camera = v.camera(&desc.camera)?;
-        if desc.image.width == 0 || desc.image.height == 0 || desc.image.width > 16384 || desc.image.height > 16384 {
-            return Err(Error::field(path, "image", format!("width and height must be in 1..=16384, got {}×{}", desc.image.width, desc.image.height)));
+        if desc.image.width == 0
+            || desc.image.height == 0
+            || desc.image.width > 16384
+            || desc.image.height > 16384
+        {
+            return Err(Error::field(
+                path,
+                "image",
+                format!(
+                    "width and height must be in 1..=16384, got {}×{}",
+                    desc.image.width, desc.image.height
+                ),
+            ));
         }
 
         let mut materials = Vec::new();
@@ -145,32 +176,64 @@ impl Scene {
             let field = format!("material[{i}].albedo");
             let albedo = v.vec3(&field, m.albedo)?;
             if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
-                return Err(Error::field(path, field, "albedo must be in [0, 1] (energy conservation)"));
+                return Err(Error::field(
+                    path,
+                    field,
+                    "albedo must be in [0, 1] (energy conservation)",
+                ));
             }
             if materials.iter().any(|x: &Material| x.name == m.name) {
-                return Err(Error::field(path, format!("material[{i}].name"), format!("duplicate material `{}`", m.name)));
+                return Err(Error::field(
+                    path,
+                    format!("material[{i}].name"),
+                    format!("duplicate material `{}`", m.name),
+                ));
             }
-            materials.push(Material { name: m.name.clone(), albedo });
+            materials.push(Material {
+                name: m.name.clone(),
+                albedo,
+            });
         }
         let material = |field: String, name: &str| -> Result<u32> {
-            materials.iter().position(|m| m.name == name).map(|i| i as u32).ok_or_else(|| {
-                let known: Vec<_> = materials.iter().map(|m| m.name.as_str()).collect();
-                Error::field(path, field, format!("unknown material `{name}` (defined: {})", known.join(", ")))
-            })
+            materials
+                .iter()
+                .position(|m| m.name == name)
+                .map(|i| i as u32)
+                .ok_or_else(|| {
+                    let known: Vec<_> = materials.iter().map(|m| m.name.as_str()).collect();
+                    Error::field(
+                        path,
+                        field,
+                        format!("unknown material `{name}` (defined: {})", known.join(", ")),
+                    )
+                })
         };
 
         let mut meshes = Vec::new();
         for (i, m) in desc.meshes.iter().enumerate() {
             let file = base.join(&m.file);
-            let bytes = std::fs::read(&file).map_err(|e| Error::field(path, format!("mesh[{i}].file"), format!("cannot read {}: {e}", file.display())))?;
+            let bytes = std::fs::read(&file).map_err(|e| {
+                Error::field(
+                    path,
+                    format!("mesh[{i}].file"),
+                    format!("cannot read {}: {e}", file.display()),
+                )
+            })?;
             hasher.update(&bytes);
             let (mut positions, triangles) = obj::load(&file)?;
             let t = &m.transform;
             if !(t.scale.is_finite() && t.scale > 0.0) {
-                return Err(Error::field(path, format!("mesh[{i}].transform.scale"), "must be finite and positive"));
+                return Err(Error::field(
+                    path,
+                    format!("mesh[{i}].transform.scale"),
+                    "must be finite and positive",
+                ));
             }
             let translate = v.vec3(&format!("mesh[{i}].transform.translate"), t.translate)?;
-            let rot = Quat::from_rotation_y(v.finite(&format!("mesh[{i}].transform.rotate_y_deg"), t.rotate_y_deg)?.to_radians());
+            let rot = Quat::from_rotation_y(
+                v.finite(&format!("mesh[{i}].transform.rotate_y_deg"), t.rotate_y_deg)?
+                    .to_radians(),
+            );
             for p in &mut positions {
                 *p = rot * (*p * t.scale) + translate;
             }
@@ -193,7 +256,11 @@ impl Scene {
                 emission: v.emission(&format!("quad[{i}].emission"), q.emission)?,
             };
             if quad.edge_u.cross(quad.edge_v).length_squared() == 0.0 {
-                return Err(Error::field(path, format!("quad[{i}]"), "edge_u and edge_v are parallel or zero: the quad has no area"));
+                return Err(Error::field(
+                    path,
+                    format!("quad[{i}]"),
+                    "edge_u and edge_v are parallel or zero: the quad has no area",
+                ));
             }
             quads.push(quad);
         }
@@ -202,7 +269,11 @@ impl Scene {
         for (i, s) in desc.spheres.iter().enumerate() {
             let radius = v.finite(&format!("sphere[{i}].radius"), s.radius)?;
             if radius <= 0.0 {
-                return Err(Error::field(path, format!("sphere[{i}].radius"), "must be positive"));
+                return Err(Error::field(
+                    path,
+                    format!("sphere[{i}].radius"),
+                    "must be positive",
+                ));
             }
             spheres.push(SphereShape {
                 center: v.vec3(&format!("sphere[{i}].center"), s.center)?,
@@ -216,7 +287,11 @@ impl Scene {
         for (i, l) in desc.point_lights.iter().enumerate() {
             let power = v.vec3(&format!("point_light[{i}].power"), l.power)?;
             if power.min_element() < 0.0 {
-                return Err(Error::field(path, format!("point_light[{i}].power"), "must be non-negative"));
+                return Err(Error::field(
+                    path,
+                    format!("point_light[{i}].power"),
+                    "must be non-negative",
+                ));
             }
             point_lights.push(PointLight {
                 position: v.vec3(&format!("point_light[{i}].position"), l.position)?,
@@ -225,7 +300,10 @@ impl Scene {
         }
 
         let scene = Scene {
-            name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into()),
+            name: path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into()),
             path: path.to_path_buf(),
             content_hash: format!("{:x}", hasher.finalize()),
             camera,
@@ -238,7 +316,11 @@ impl Scene {
             point_lights,
         };
         if !scene.has_emitters() && !scene.has_delta_lights() {
-            return Err(Error::field(path, "light", "the scene has no light: add an `emission` to a shape or a [[point_light]]"));
+            return Err(Error::field(
+                path,
+                "light",
+                "the scene has no light: add an `emission` to a shape or a [[point_light]]",
+            ));
         }
         Ok(scene)
     }
@@ -250,18 +332,38 @@ struct Validator<'a> {
 
 impl Validator<'_> {
     fn finite(&self, field: &str, x: f32) -> Result<f32> {
-        if x.is_finite() { Ok(x) } else { Err(Error::field(self.path, field, format!("must be finite, got {x}"))) }
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(Error::field(
+                self.path,
+                field,
+                format!("must be finite, got {x}"),
+            ))
+        }
     }
 
     fn vec3(&self, field: &str, a: [f32; 3]) -> Result<Vec3> {
-        if a.iter().all(|c| c.is_finite()) { Ok(Vec3::from_array(a)) } else { Err(Error::field(self.path, field, format!("must be finite, got {a:?}"))) }
+        if a.iter().all(|c| c.is_finite()) {
+            Ok(Vec3::from_array(a))
+        } else {
+            Err(Error::field(
+                self.path,
+                field,
+                format!("must be finite, got {a:?}"),
+            ))
+        }
     }
 
     fn emission(&self, field: &str, e: Option<[f32; 3]>) -> Result<Option<Vec3>> {
         let Some(e) = e else { return Ok(None) };
         let e = self.vec3(field, e)?;
         if e.min_element() < 0.0 {
-            return Err(Error::field(self.path, field, format!("radiance must be non-negative, got {e}")));
+            return Err(Error::field(
+                self.path,
+                field,
+                format!("radiance must be non-negative, got {e}"),
+            ));
         }
         Ok(Some(e))
     }
@@ -272,16 +374,34 @@ impl Validator<'_> {
         let up = self.vec3("camera.up", c.up)?;
         let fov = self.finite("camera.fov_y_deg", c.fov_y_deg)?;
         if !(fov > 0.0 && fov < 180.0) {
-            return Err(Error::field(self.path, "camera.fov_y_deg", format!("must be in (0, 180), got {fov}")));
+            return Err(Error::field(
+                self.path,
+                "camera.fov_y_deg",
+                format!("must be in (0, 180), got {fov}"),
+            ));
         }
         let forward = (look_at - eye).normalize_or_zero();
         if forward == Vec3::ZERO {
-            return Err(Error::field(self.path, "camera.look_at", "equals camera.eye"));
+            return Err(Error::field(
+                self.path,
+                "camera.look_at",
+                "equals camera.eye",
+            ));
         }
         let right = forward.cross(up).normalize_or_zero();
         if right == Vec3::ZERO {
-            return Err(Error::field(self.path, "camera.up", "is parallel to the viewing direction"));
+            return Err(Error::field(
+                self.path,
+                "camera.up",
+                "is parallel to the viewing direction",
+            ));
         }
-        Ok(Camera { eye, forward, right, up: right.cross(forward), tan_half_fov_y: (0.5 * fov.to_radians()).tan() })
+        Ok(Camera {
+            eye,
+            forward,
+            right,
+            up: right.cross(forward),
+            tan_half_fov_y: (0.5 * fov.to_radians()).tan(),
+        })
     }
 }

@@ -6,9 +6,15 @@ use glam::Vec3;
 use std::path::Path;
 
 pub fn load(file: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>)> {
-    let opts = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let (models, _) = tobj::load_obj(file, &opts)
-        .map_err(|e| Error::Parse { path: file.to_path_buf(), message: format!("not a readable OBJ mesh: {e}") })?;
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(file, &opts).map_err(|e| Error::Parse {
+        path: file.to_path_buf(),
+        message: format!("not a readable OBJ mesh: {e}"),
+    })?;
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     for m in models {
@@ -18,7 +24,11 @@ pub fn load(file: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>)> {
             if !p.iter().all(|c| c.is_finite()) {
                 return Err(Error::Parse {
                     path: file.to_path_buf(),
-                    message: format!("vertex {} of object `{}` is not finite: {p:?}", k + 1, m.name),
+                    message: format!(
+                        "vertex {} of object `{}` is not finite: {p:?}",
+                        k + 1,
+                        m.name
+                    ),
                 });
             }
             positions.push(Vec3::new(p[0], p[1], p[2]));
@@ -28,14 +38,22 @@ pub fn load(file: &Path) -> Result<(Vec<Vec3>, Vec<[u32; 3]>)> {
             if let Some(bad) = f.iter().find(|&&i| i >= n) {
                 return Err(Error::Parse {
                     path: file.to_path_buf(),
-                    message: format!("face {} of object `{}` uses vertex {} but there are {n}", k + 1, m.name, bad + 1),
+                    message: format!(
+                        "face {} of object `{}` uses vertex {} but there are {n}",
+                        k + 1,
+                        m.name,
+                        bad + 1
+                    ),
                 });
             }
             triangles.push([base + f[0], base + f[1], base + f[2]]);
         }
     }
     if triangles.is_empty() {
-        return Err(Error::Parse { path: file.to_path_buf(), message: "no triangles".into() });
+        return Err(Error::Parse {
+            path: file.to_path_buf(),
+            message: "no triangles".into(),
+        });
     }
     Ok((positions, triangles))
 }

@@ -31,11 +31,17 @@ impl Strategy for CosineHemisphere {
     fn sample(&self, _scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes {
         let local = sample_cosine_hemisphere(rng.next_2d());
         // z = 0 has pdf 0: a measure-zero event with no contribution, never a division by 0.
-        if !(local.z > 0.0) {
+        if local.z <= 0.0 {
             return Probes::default();
         }
         let dir = Frame::from_normal(sp.n).to_world(local).normalize();
         let ray = Ray::new(sp.origin, dir, f32::INFINITY);
-        Probes { shadow: None, emission: Some(EmissionProbe { ray, weight: sp.albedo }) }
+        Probes {
+            shadow: None,
+            emission: Some(EmissionProbe {
+                ray,
+                weight: sp.albedo,
+            }),
+        }
     }
 }

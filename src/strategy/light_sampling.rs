@@ -28,13 +28,20 @@ impl Strategy for LightSampling {
     fn sample(&self, scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes {
         let u_select = rng.next_1d();
         let u = [rng.next_1d(), rng.next_1d(), rng.next_1d()];
-        let Some((_, ls)) = scene.sample_light(sp.p, u_select, u) else { return Probes::default() };
+        let Some((_, ls)) = scene.sample_light(sp.p, u_select, u) else {
+            return Probes::default();
+        };
         let cos = sp.n.dot(ls.wi);
-        if !(cos > 0.0) {
+        if cos <= 0.0 {
             return Probes::default();
         }
-        let Some(ray) = ls.shadow_ray(sp.origin) else { return Probes::default() };
+        let Some(ray) = ls.shadow_ray(sp.origin) else {
+            return Probes::default();
+        };
         let value = Lambertian { albedo: sp.albedo }.eval() * ls.radiance * (cos / ls.pdf);
-        Probes { shadow: Some(ShadowProbe { ray, value }), emission: None }
+        Probes {
+            shadow: Some(ShadowProbe { ray, value }),
+            emission: None,
+        }
     }
 }

@@ -3,9 +3,11 @@
 //! the probes as packets; a strategy never sees the tracer.
 
 pub mod cosine_hemisphere;
+pub mod estimate;
 pub mod light_sampling;
 
 use crate::geometry::Ray;
+use crate::math::offset_ray_origin;
 use crate::prepare::PreparedScene;
 use crate::sampling::stream::SampleStream;
 use glam::Vec3;
@@ -18,6 +20,20 @@ pub struct ShadingPoint {
     pub origin: Vec3,
     pub n: Vec3,
     pub albedo: Vec3,
+}
+
+impl ShadingPoint {
+    /// A point seen along `view_dir` (pointing at the surface): the normal is flipped to the
+    /// viewer's side and the ray origin offset along it.
+    pub fn new(p: Vec3, ng: Vec3, view_dir: Vec3, albedo: Vec3) -> Self {
+        let n = if ng.dot(view_dir) < 0.0 { ng } else { -ng };
+        ShadingPoint {
+            p,
+            origin: offset_ray_origin(p, n),
+            n,
+            albedo,
+        }
+    }
 }
 
 /// What one sample asks the tracer. The contribution is
@@ -55,7 +71,10 @@ pub trait Strategy: Send + Sync {
 
 /// Every strategy dibench knows, in listing order.
 pub fn registry() -> Vec<Box<dyn Strategy>> {
-    vec![Box::new(light_sampling::LightSampling), Box::new(cosine_hemisphere::CosineHemisphere)]
+    vec![
+        Box::new(light_sampling::LightSampling),
+        Box::new(cosine_hemisphere::CosineHemisphere),
+    ]
 }
 
 /// The strategy references are rendered with: unbiased for every scene with a light.
@@ -67,15 +86,24 @@ pub fn by_name(name: &str) -> Option<Box<dyn Strategy>> {
     registry().into_iter().find(|s| s.name() == name)
 }
 
-/// Splits the registry into the strategies that apply to the scene and (name, reason) for the
-/// ones that do not.
-pub fn applicable(scene: &PreparedScene) -> (Vec<Box<dyn Strategy>>, Vec<(String, String)>) {
+/// A strategy left out of a run, and why.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Skipped {
+    pub name: String,
+    pub reason: String,
+}
+
+/// Splits the registry into the strategies that apply to the scene and the ones that do not.
+pub fn applicable(scene: &PreparedScene) -> (Vec<Box<dyn Strategy>>, Vec<Skipped>) {
     let mut run = Vec::new();
     let mut skipped = Vec::new();
     for s in registry() {
         match s.applies(scene) {
             Ok(()) => run.push(s),
-            Err(why) => skipped.push((s.name().to_string(), why)),
+            Err(reason) => skipped.push(Skipped {
+                name: s.name().to_string(),
+                reason,
+            }),
         }
     }
     (run, skipped)

@@ -34,17 +34,31 @@ impl ObvhsTracer {
             .iter()
             .map(|t| {
                 let (a, b, c) = (t.v0.into(), t.v1.into(), t.v2.into());
-                PrimBounds(Aabb::new(glam::Vec3A::min(a, b).min(c), glam::Vec3A::max(a, b).max(c)))
+                PrimBounds(Aabb::new(
+                    glam::Vec3A::min(a, b).min(c),
+                    glam::Vec3A::max(a, b).max(c),
+                ))
             })
             .collect();
         bounds.extend(geometry.spheres.iter().map(|s| {
             let r = glam::Vec3A::splat(s.radius);
-            PrimBounds(Aabb::new(glam::Vec3A::from(s.center) - r, glam::Vec3A::from(s.center) + r))
+            PrimBounds(Aabb::new(
+                glam::Vec3A::from(s.center) - r,
+                glam::Vec3A::from(s.center) + r,
+            ))
         }));
         let mut build_time = std::time::Duration::ZERO;
-        let bvh = obvhs::bvh2::builder::build_bvh2(&bounds, BvhBuildParams::medium_build(), &mut build_time);
+        let bvh = obvhs::bvh2::builder::build_bvh2(
+            &bounds,
+            BvhBuildParams::medium_build(),
+            &mut build_time,
+        );
         let slot_prim = bvh.primitive_indices.clone();
-        ObvhsTracer { geometry, bvh, slot_prim }
+        ObvhsTracer {
+            geometry,
+            bvh,
+            slot_prim,
+        }
     }
 
     pub fn geometry(&self) -> &Geometry {
@@ -66,7 +80,13 @@ impl ObvhsTracer {
                 Some(h) => (h.t, h.b1, h.b2),
                 None => (f32::INFINITY, 0.0, 0.0),
             },
-            Some(s) => (self.geometry.spheres[s].intersect(ray).unwrap_or(f32::INFINITY), 0.0, 0.0),
+            Some(s) => (
+                self.geometry.spheres[s]
+                    .intersect(ray)
+                    .unwrap_or(f32::INFINITY),
+                0.0,
+                0.0,
+            ),
         }
     }
 }
@@ -81,17 +101,23 @@ impl Tracer for ObvhsTracer {
             return None;
         }
         let wr = WatertightRay::new(ray.dir);
-        let mut best = Hit { t: ray.tmax, prim: u32::MAX, u: 0.0, v: 0.0 };
+        let mut best = Hit {
+            t: ray.tmax,
+            prim: u32::MAX,
+            u: 0.0,
+            v: 0.0,
+        };
         let mut hit = RayHit::none();
-        self.bvh.ray_traverse(Self::to_bvh_ray(ray), &mut hit, |r, slot| {
-            let prim = self.slot_prim[slot];
-            // Leaves are tested against the shrinking closest distance obvhs keeps in r.tmax.
-            let (t, u, v) = self.hit_prim(&Ray::new(ray.origin, ray.dir, r.tmax), &wr, prim);
-            if t < best.t {
-                best = Hit { t, prim, u, v };
-            }
-            t
-        });
+        self.bvh
+            .ray_traverse(Self::to_bvh_ray(ray), &mut hit, |r, slot| {
+                let prim = self.slot_prim[slot];
+                // Leaves are tested against the shrinking closest distance obvhs keeps in r.tmax.
+                let (t, u, v) = self.hit_prim(&Ray::new(ray.origin, ray.dir, r.tmax), &wr, prim);
+                if t < best.t {
+                    best = Hit { t, prim, u, v };
+                }
+                t
+            });
         (best.prim != u32::MAX).then_some(best)
     }
 
@@ -100,6 +126,10 @@ impl Tracer for ObvhsTracer {
             return false;
         }
         let wr = WatertightRay::new(ray.dir);
-        !self.bvh.ray_traverse_miss(Self::to_bvh_ray(ray), |_, slot| self.hit_prim(ray, &wr, self.slot_prim[slot]).0)
+        !self
+            .bvh
+            .ray_traverse_miss(Self::to_bvh_ray(ray), |_, slot| {
+                self.hit_prim(ray, &wr, self.slot_prim[slot]).0
+            })
     }
 }

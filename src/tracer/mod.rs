@@ -78,13 +78,23 @@ pub const NO_HIT: u32 = u32::MAX;
 
 impl Default for HitPacket {
     fn default() -> Self {
-        HitPacket { t: [f32::INFINITY; LANES], u: [0.0; LANES], v: [0.0; LANES], prim: [NO_HIT; LANES] }
+        HitPacket {
+            t: [f32::INFINITY; LANES],
+            u: [0.0; LANES],
+            v: [0.0; LANES],
+            prim: [NO_HIT; LANES],
+        }
     }
 }
 
 impl HitPacket {
     pub fn get(&self, lane: usize) -> Option<Hit> {
-        (self.prim[lane] != NO_HIT).then(|| Hit { t: self.t[lane], prim: self.prim[lane], u: self.u[lane], v: self.v[lane] })
+        (self.prim[lane] != NO_HIT).then(|| Hit {
+            t: self.t[lane],
+            prim: self.prim[lane],
+            u: self.u[lane],
+            v: self.v[lane],
+        })
     }
 
     pub fn set(&mut self, lane: usize, hit: Option<Hit>) {
@@ -134,7 +144,11 @@ pub trait Tracer: Send + Sync {
     /// Closest hits of the active lanes; inactive lanes come back as misses.
     fn intersect_packet(&self, rays: &RayPacket, active: LaneMask, hits: &mut HitPacket) {
         for lane in 0..LANES {
-            let hit = if active & (1 << lane) != 0 { self.intersect(&rays.get(lane)) } else { None };
+            let hit = if active & (1 << lane) != 0 {
+                self.intersect(&rays.get(lane))
+            } else {
+                None
+            };
             hits.set(lane, hit);
         }
     }
