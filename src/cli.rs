@@ -104,16 +104,18 @@ pub fn run(cli: Cli) -> Result<()> {
 fn run_reference(a: ReferenceArgs) -> Result<()> {
     let (pool, threads) = pool(a.common.threads)?;
     let scene = load(&a.common.scene)?;
-    let (image, meta) =
-        pool.install(|| reference::render(&scene, a.spp, a.common.seed, threads))?;
-    let path = reference::save(&a.common.out, &image, &meta)?;
-    println!(
-        "reference: {} ({} spp, {:.1} s, strategy {})",
-        path.display(),
-        meta.spp,
-        meta.wall_time_s,
-        meta.strategy
-    );
+    for integrand in strategy::integrands(&scene) {
+        let (image, meta) =
+            pool.install(|| reference::render(&scene, integrand, a.spp, a.common.seed, threads))?;
+        let path = reference::save(&a.common.out, &image, &meta)?;
+        println!(
+            "reference: {} ({} spp, {:.1} s, strategy {})",
+            path.display(),
+            meta.spp,
+            meta.wall_time_s,
+            meta.strategy
+        );
+    }
     Ok(())
 }
 
@@ -153,60 +155,82 @@ fn run_compare(a: CompareArgs) -> Result<()> {
         eprintln!("skipping strategy `{}`: {}", k.name, k.reason);
     }
     pool.install(|| -> Result<()> {
-        let (reference, ref_meta) =
-            match reference::load_matching(&a.common.out, &scene, a.reference_spp)? {
+        let mut images = Vec::new();
+        for integrand in strategy::integrands(&scene) {
+            if !run.iter().any(|s| s.integrand() == integrand) {
+                continue;
+            }
+            let dir = reference::reference_dir(&a.common.out, &scene.scene.name);
+            let (image, meta) = match reference::load_matching(
+                &a.common.out,
+                &scene,
+                integrand,
+                a.reference_spp,
+            )? {
                 Some(r) => {
                     eprintln!(
-                        "reference: reusing {} spp from {}",
+                        "reference ({}): reusing {} spp from {}",
+                        integrand.name(),
                         r.1.spp,
-                        reference::reference_dir(&a.common.out, &scene.scene.name).display()
+                        dir.display()
                     );
                     r
                 }
                 None => {
                     eprintln!(
-                        "reference: rendering {} spp (no matching one stored)",
+                        "reference ({}): rendering {} spp (no matching one stored)",
+                        integrand.name(),
                         a.reference_spp
                     );
-                    let (img, meta) =
-                        reference::render(&scene, a.reference_spp, a.common.seed, threads)?;
+                    let (img, meta) = reference::render(
+                        &scene,
+                        integrand,
+                        a.reference_spp,
+                        a.common.seed,
+                        threads,
+                    )?;
                     reference::save(&a.common.out, &img, &meta)?;
-                    eprintln!("reference: {:.1} s", meta.wall_time_s);
+                    eprintln!(
+                        "reference ({}): {:.1} s with `{}`",
+                        integrand.name(),
+                        meta.wall_time_s,
+                        meta.strategy
+                    );
                     (img, meta)
                 }
             };
+            images.push((integrand, image, meta.spp));
+        }
+        let references = compare::References { images };
         let opts = compare::CompareOptions {
             time_s: a.time,
             seed: a.common.seed,
             threads,
         };
-        let report = compare::run(
-            &scene,
-            &run,
-            skipped,
-            &reference,
-            ref_meta.spp,
-            &a.common.out,
-            &opts,
-        )?;
+        let report = compare::run(&scene, &run, skipped, &references, &a.common.out, &opts)?;
+        let spp: Vec<String> = references
+            .images
+            .iter()
+            .map(|(i, _, n)| format!("{} {n} spp", i.name()))
+            .collect();
         println!(
-            "scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {} spp",
+            "scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {}",
             scene.scene.name,
             scene.tracer.name(),
             threads,
             a.common.seed,
             a.time,
-            ref_meta.spp
+            spp.join(", ")
         );
         println!(
-            "{:<12} {:>8} {:>9} {:>12} {:>12}",
-            "strategy", "spp", "time_s", "rmse", "relmse"
+            "{:<18} {:>9} {:>8} {:>9} {:>12} {:>12}",
+            "strategy", "integrand", "spp", "time_s", "rmse", "relmse"
         );
         for s in &run {
             if let Some(last) = report.rows.iter().rev().find(|r| r.strategy == s.name()) {
                 println!(
-                    "{:<12} {:>8} {:>9.3} {:>12.5e} {:>12.5e}",
-                    last.strategy, last.spp, last.time_s, last.rmse, last.relmse
+                    "{:<18} {:>9} {:>8} {:>9.3} {:>12.5e} {:>12.5e}",
+                    last.strategy, last.integrand, last.spp, last.time_s, last.rmse, last.relmse
                 );
             }
         }
@@ -225,7 +249,7 @@ fn run_strategies(scene: Option<String>) -> Result<()> {
                 Err(why) => format!("  [skipped: {why}]"),
             },
         };
-        println!("{:<12} {}{status}", s.name(), s.describe());
+        println!("{:<18} {}{status}", s.name(), s.describe());
     }
     Ok(())
 }

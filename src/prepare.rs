@@ -1,14 +1,17 @@
 //! Scene → what the renderer needs, and only that: the triangles and spheres the tracer
 //! intersects, per-primitive materials, and light structures only for the lights present.
 
+use crate::bsdf::Bsdf;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
+use crate::lights::directional::DirectionalLight;
 use crate::lights::mesh::MeshLight;
 use crate::lights::point::PointLight;
 use crate::lights::quad::QuadLight;
 use crate::lights::sphere::SphereLight;
-use crate::lights::{Light, LightSample};
+use crate::lights::spot::SpotLight;
+use crate::lights::{Light, LightMethods, LightSample, QuadMethod};
 use crate::sampling::discrete::DiscreteDistribution;
 use crate::scene::Scene;
 use crate::tracer::bvh::ObvhsTracer;
@@ -29,6 +32,7 @@ pub struct PreparedScene {
     pub tracer: Box<dyn Tracer>,
     pub prim_material: Vec<u32>,
     pub prim_emitter: Vec<Option<EmitterRef>>,
+    pub bsdfs: Vec<Bsdf>,
     pub lights: Vec<Light>,
     /// Power-proportional light selection; None when no light has positive power.
     pub light_selection: Option<DiscreteDistribution>,
@@ -125,6 +129,30 @@ impl PreparedScene {
                 intensity: p.intensity,
             }));
         }
+        for s in &scene.spot_lights {
+            lights.push(Light::Spot(SpotLight {
+                position: s.position,
+                axis: s.direction,
+                intensity: s.intensity,
+                cos_cone: s.cos_cone,
+                cos_falloff_start: s.cos_falloff_start,
+            }));
+        }
+        if !scene.directional_lights.is_empty() {
+            let scene_radius = bounding_radius(&g, &scene.camera);
+            for d in &scene.directional_lights {
+                lights.push(Light::Directional(DirectionalLight {
+                    to_light: -d.direction,
+                    irradiance: d.irradiance,
+                    scene_radius,
+                }));
+            }
+        }
+        let bsdfs = scene
+            .materials
+            .iter()
+            .map(|m| Bsdf::new(m.albedo, m.specular, m.exponent))
+            .collect();
 
         let light_selection = if lights.is_empty() {
             None
@@ -139,6 +167,7 @@ impl PreparedScene {
             tracer,
             prim_material,
             prim_emitter,
+            bsdfs,
             lights,
             light_selection,
         }
@@ -173,26 +202,65 @@ impl PreparedScene {
         }
     }
 
-    /// Radiance arriving back along `ray` from what it hit.
-    pub fn emitted_at(&self, ray: &Ray, hit: &Hit) -> Vec3 {
-        if self.prim_emitter[hit.prim as usize].is_none() {
-            return Vec3::ZERO;
-        }
-        self.emitted(&self.surface(ray, hit), ray.dir)
-    }
-
-    /// Picks a light by power and samples it with its default sampler; the returned pdf
-    /// includes the selection probability.
+    /// Picks a light by power and samples it by `methods`; the returned pdf includes the
+    /// selection probability.
     pub fn sample_light(
         &self,
         p: Vec3,
         u_select: f32,
         u: [f32; 3],
+        methods: &LightMethods,
     ) -> Option<(usize, LightSample)> {
         let sel = self.light_selection.as_ref()?;
         let i = sel.sample(u_select);
-        let mut s = self.lights[i].sample(p, u)?;
+        let mut s = self.lights[i].sample(p, u, methods)?;
         s.pdf *= sel.pmf(i);
         Some((i, s))
     }
+
+    /// The pdf with which [`Self::sample_light`] produces the direction from p to point q of
+    /// the emitter `e` (selection probability included).
+    pub fn light_pdf(&self, p: Vec3, q: Vec3, e: EmitterRef, methods: &LightMethods) -> f32 {
+        let Some(sel) = self.light_selection.as_ref() else {
+            return 0.0;
+        };
+        sel.pmf(e.light as usize) * self.lights[e.light as usize].pdf(p, q, e.local, methods)
+    }
+
+    /// True if the scene has a light `kind` accepts.
+    pub fn has_light(&self, kind: impl Fn(&Light) -> bool) -> bool {
+        self.lights.iter().any(kind)
+    }
+
+    /// `methods` with what this scene cannot use replaced: spherical-rectangle sampling needs
+    /// rectangles, not general parallelograms.
+    pub fn usable_methods(&self, mut methods: LightMethods) -> LightMethods {
+        if self
+            .lights
+            .iter()
+            .any(|l| matches!(l, Light::Quad(q) if !q.is_rectangle()))
+        {
+            methods.quad = QuadMethod::Area;
+        }
+        methods
+    }
+}
+
+/// Radius of a bounding sphere (about the box centre) of the geometry, the camera and the
+/// point it looks at, so it is positive even for a scene with no geometry.
+fn bounding_radius(g: &Geometry, camera: &crate::scene::Camera) -> f32 {
+    let look_at = camera.eye + camera.forward;
+    let mut lo = camera.eye.min(look_at);
+    let mut hi = camera.eye.max(look_at);
+    for t in &g.triangles {
+        for v in [t.v0, t.v1, t.v2] {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    for s in &g.spheres {
+        lo = lo.min(s.center - s.radius);
+        hi = hi.max(s.center + s.radius);
+    }
+    0.5 * (hi - lo).length()
 }

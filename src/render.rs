@@ -6,7 +6,7 @@ use crate::geometry::Ray;
 use crate::prepare::PreparedScene;
 use crate::sampling::stream::{SampleStream, name_id};
 use crate::scene::Camera;
-use crate::strategy::{ShadingPoint, Strategy};
+use crate::strategy::{Integrand, ShadingPoint, Strategy};
 use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -72,22 +72,27 @@ impl<'a> Renderer<'a> {
         let mut shadow_value = [Vec3::ZERO; LANES];
         let mut shadow_mask: LaneMask = 0;
         let mut emit = RayPacket::default();
-        let mut emit_weight = [Vec3::ZERO; LANES];
+        let mut emit_probe = [None; LANES];
         let mut emit_mask: LaneMask = 0;
+        let mut points: [Option<ShadingPoint>; LANES] = [None; LANES];
+        let direct = self.strategy.integrand() == Integrand::Direct;
         for lane in 0..LANES {
             let (Some(hit), Some(rng)) = (hits.get(lane), rngs[lane].as_mut()) else {
                 continue;
             };
             let ray = cam.get(lane);
             let surf = scene.surface(&ray, &hit);
-            radiance[lane] += scene.emitted(&surf, ray.dir);
+            if direct {
+                radiance[lane] += scene.emitted(&surf, ray.dir);
+            }
             let sp = ShadingPoint::new(
                 surf.p,
                 surf.ng,
                 ray.dir,
-                scene.scene.materials[surf.material as usize].albedo,
+                scene.bsdfs[surf.material as usize],
             );
             let probes = self.strategy.sample(scene, &sp, rng);
+            points[lane] = Some(sp);
             if let Some(s) = probes.shadow {
                 shadow.set(lane, &s.ray);
                 shadow_value[lane] = s.value;
@@ -95,7 +100,7 @@ impl<'a> Renderer<'a> {
             }
             if let Some(e) = probes.emission {
                 emit.set(lane, &e.ray);
-                emit_weight[lane] = e.weight;
+                emit_probe[lane] = Some(e);
                 emit_mask |= 1 << lane;
             }
         }
@@ -111,9 +116,12 @@ impl<'a> Renderer<'a> {
             let mut ehits = HitPacket::default();
             scene.tracer.intersect_packet(&emit, emit_mask, &mut ehits);
             for lane in 0..LANES {
-                if let Some(hit) = ehits.get(lane) {
-                    radiance[lane] += emit_weight[lane] * scene.emitted_at(&emit.get(lane), &hit);
-                }
+                let (Some(hit), Some(probe), Some(sp)) =
+                    (ehits.get(lane), emit_probe[lane], points[lane])
+                else {
+                    continue;
+                };
+                radiance[lane] += emission_contribution(scene, self.strategy, &sp, &probe, &hit);
             }
         }
         radiance
@@ -130,4 +138,23 @@ pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ra
         (c.forward + c.right * sx + c.up * sy).normalize(),
         f32::INFINITY,
     )
+}
+
+/// What an emission probe that hit `hit` adds: weight · Le · the strategy's MIS weight.
+pub fn emission_contribution(
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    sp: &ShadingPoint,
+    probe: &crate::strategy::EmissionProbe,
+    hit: &crate::geometry::Hit,
+) -> Vec3 {
+    if scene.prim_emitter[hit.prim as usize].is_none() {
+        return Vec3::ZERO;
+    }
+    let surf = scene.surface(&probe.ray, hit);
+    let le = scene.emitted(&surf, probe.ray.dir);
+    if le == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    probe.weight * le * strategy.emission_weight(scene, sp, probe, &surf)
 }

@@ -213,9 +213,9 @@ fn cli_compare_writes_exrs_and_csv() {
     let header = csv.lines().next().unwrap();
     assert_eq!(
         header,
-        "scene,strategy,backend,threads,seed,checkpoint,time_s,spp,rmse,relmse"
+        "scene,strategy,integrand,backend,threads,seed,checkpoint,time_s,spp,rmse,relmse"
     );
-    for s in ["light", "cosine"] {
+    for s in ["light", "cosine", "mis-power"] {
         assert!(
             runs[0].join(format!("{s}.exr")).is_file(),
             "{s}.exr missing"
@@ -225,7 +225,7 @@ fn cli_compare_writes_exrs_and_csv() {
             "no rows for {s}"
         );
     }
-    assert!(dir.path().join("out/ok/reference/reference.exr").is_file());
+    assert!(dir.path().join("out/ok/reference/direct.exr").is_file());
     let leftovers: Vec<_> = walk(&dir.path().join("out"))
         .into_iter()
         .filter(|p| p.to_string_lossy().contains(".tmp-"))

@@ -9,7 +9,7 @@ use crate::metrics::{relmse, rmse};
 use crate::output::{write_csv, write_exr, write_json};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
-use crate::strategy::{Skipped, Strategy};
+use crate::strategy::{Integrand, Skipped, Strategy};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -28,6 +28,7 @@ pub struct CompareOptions {
 pub struct ResultRow {
     pub scene: String,
     pub strategy: String,
+    pub integrand: String,
     pub backend: String,
     pub threads: usize,
     pub seed: u64,
@@ -50,7 +51,7 @@ struct RunMeta<'a> {
     budget_s: f64,
     strategies: Vec<&'a str>,
     skipped: &'a [Skipped],
-    reference_spp: u64,
+    reference_spp: &'a [(String, u64)],
     dibench_version: &'a str,
     commit: &'a str,
 }
@@ -81,6 +82,7 @@ pub fn run_strategy(
             rows.push(ResultRow {
                 scene: scene.scene.name.clone(),
                 strategy: strategy.name().to_string(),
+                integrand: strategy.integrand().name().to_string(),
                 backend: scene.tracer.name().to_string(),
                 threads: opts.threads,
                 seed: opts.seed,
@@ -105,6 +107,20 @@ pub struct CompareReport {
     pub skipped: Vec<Skipped>,
 }
 
+/// A reference image (and its spp) per integrand the compared strategies need.
+pub struct References {
+    pub images: Vec<(Integrand, Image, u64)>,
+}
+
+impl References {
+    fn get(&self, i: Integrand) -> Option<&Image> {
+        self.images
+            .iter()
+            .find(|(k, _, _)| *k == i)
+            .map(|(_, img, _)| img)
+    }
+}
+
 /// Runs `strategies` at equal time and writes `<out>/<scene>/<run-id>/`: one EXR per strategy,
 /// `results.csv` (rewritten after each strategy, so an interrupted run keeps what finished)
 /// and `run.json`.
@@ -112,8 +128,7 @@ pub fn run(
     scene: &PreparedScene,
     strategies: &[Box<dyn Strategy>],
     skipped: Vec<Skipped>,
-    reference: &Image,
-    reference_spp: u64,
+    references: &References,
     out: &Path,
     opts: &CompareOptions,
 ) -> Result<CompareReport> {
@@ -146,7 +161,11 @@ pub fn run(
         budget_s: opts.time_s,
         strategies: strategies.iter().map(|s| s.name()).collect(),
         skipped: &skipped,
-        reference_spp,
+        reference_spp: &references
+            .images
+            .iter()
+            .map(|(i, _, spp)| (i.name().to_string(), *spp))
+            .collect::<Vec<_>>(),
         dibench_version: VERSION,
         commit: COMMIT,
     };
@@ -159,6 +178,13 @@ pub fn run(
             format!("{:<10}", s.name()),
             "{prefix} [{bar:30}] {msg}",
         );
+        let reference = references.get(s.integrand()).ok_or_else(|| {
+            Error::Usage(format!(
+                "no {} reference for strategy `{}`",
+                s.integrand().name(),
+                s.name()
+            ))
+        })?;
         let (image, mut r) = run_strategy(scene, s.as_ref(), reference, opts, |t| {
             bar.set_position(t.as_millis() as u64);
         });

@@ -8,7 +8,7 @@ use crate::math::mix64;
 use crate::output::{read_exr, write_exr, write_json};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
-use crate::strategy::reference_strategy;
+use crate::strategy::{Integrand, reference_strategy};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -16,6 +16,7 @@ use std::time::Instant;
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ReferenceMeta {
     pub scene: String,
+    pub integrand: String,
     pub scene_hash: String,
     pub width: u32,
     pub height: u32,
@@ -42,6 +43,7 @@ fn reference_stream_seed(seed: u64) -> u64 {
 
 pub fn render(
     scene: &PreparedScene,
+    integrand: Integrand,
     spp: u64,
     seed: u64,
     threads: usize,
@@ -49,17 +51,17 @@ pub fn render(
     if spp == 0 {
         return Err(Error::Usage("--spp must be at least 1".into()));
     }
-    let strategy = reference_strategy();
-    strategy.applies(scene).map_err(|why| {
+    let strategy = reference_strategy(scene, integrand).ok_or_else(|| {
         Error::Usage(format!(
-            "scene `{}`: cannot render a reference: {why}",
-            scene.scene.name
+            "scene `{}`: no strategy can render a {} reference",
+            scene.scene.name,
+            integrand.name()
         ))
     })?;
     let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
     let bar = progress_bar(
         spp,
-        format!("reference {}", scene.scene.name),
+        format!("reference {} {}", scene.scene.name, integrand.name()),
         "{prefix} [{bar:30}] {pos}/{len} spp, eta {eta}",
     );
     let start = Instant::now();
@@ -73,6 +75,7 @@ pub fn render(
     bar.finish_and_clear();
     let meta = ReferenceMeta {
         scene: scene.scene.name.clone(),
+        integrand: integrand.name().to_string(),
         scene_hash: scene.scene.content_hash.clone(),
         width: scene.scene.width,
         height: scene.scene.height,
@@ -90,9 +93,9 @@ pub fn render(
 
 pub fn save(out: &Path, image: &Image, meta: &ReferenceMeta) -> Result<PathBuf> {
     let dir = reference_dir(out, &meta.scene);
-    let exr = dir.join("reference.exr");
+    let exr = dir.join(format!("{}.exr", meta.integrand));
     write_exr(&exr, image)?;
-    write_json(&dir.join("reference.json"), meta)?;
+    write_json(&dir.join(format!("{}.json", meta.integrand)), meta)?;
     Ok(exr)
 }
 
@@ -100,10 +103,11 @@ pub fn save(out: &Path, image: &Image, meta: &ReferenceMeta) -> Result<PathBuf> 
 pub fn load_matching(
     out: &Path,
     scene: &PreparedScene,
+    integrand: Integrand,
     min_spp: u64,
 ) -> Result<Option<(Image, ReferenceMeta)>> {
     let dir = reference_dir(out, &scene.scene.name);
-    let json = dir.join("reference.json");
+    let json = dir.join(format!("{}.json", integrand.name()));
     let Ok(text) = std::fs::read_to_string(&json) else {
         return Ok(None);
     };
@@ -118,7 +122,7 @@ pub fn load_matching(
     {
         return Ok(None);
     }
-    let image = read_exr(&dir.join("reference.exr"))?;
+    let image = read_exr(&dir.join(format!("{}.exr", integrand.name())))?;
     if image.width != meta.width || image.height != meta.height {
         return Ok(None);
     }

@@ -2,10 +2,12 @@
 //! Every sampler returns its pdf in solid angle at the shading point, the measure of the
 //! direct-illumination integral, or reports a delta light.
 
+pub mod directional;
 pub mod mesh;
 pub mod point;
 pub mod quad;
 pub mod sphere;
+pub mod spot;
 
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
@@ -24,6 +26,60 @@ pub struct LightSample {
     pub radiance: Vec3,
     /// Solid-angle pdf; 1 for a delta light.
     pub pdf: f32,
+    /// A light at infinity (directional): the shadow ray is unbounded and `point` unused.
+    pub distant: bool,
+}
+
+/// How quads are sampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum QuadMethod {
+    /// Uniform by area.
+    Area,
+    /// Uniform in solid angle (spherical rectangle, Ureña et al. 2013).
+    SolidAngle,
+}
+
+/// How spheres are sampled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SphereMethod {
+    /// Uniform by area over the whole sphere (back-facing samples count as misses).
+    Area,
+    /// Uniform by area over the cap visible from the shading point.
+    Cap,
+    /// Uniform in the cone of directions the sphere subtends.
+    Cone,
+}
+
+/// How emissive meshes are sampled, after a triangle is chosen in proportion to its area.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MeshMethod {
+    /// Uniform by area on the triangle.
+    Area,
+    /// Uniform in the triangle's solid angle (spherical triangle, Arvo 1995).
+    SolidAngle,
+}
+
+/// The sampler used for each kind of area light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LightMethods {
+    pub quad: QuadMethod,
+    pub sphere: SphereMethod,
+    pub mesh: MeshMethod,
+}
+
+impl LightMethods {
+    /// The lecture's baseline: area sampling for quads and meshes, the cone for spheres.
+    pub const BASIC: LightMethods = LightMethods {
+        quad: QuadMethod::Area,
+        sphere: SphereMethod::Cone,
+        mesh: MeshMethod::Area,
+    };
+    /// The lowest-variance sampler of each kind: solid angle everywhere.
+    pub const SOLID_ANGLE: LightMethods = LightMethods {
+        quad: QuadMethod::SolidAngle,
+        sphere: SphereMethod::Cone,
+        mesh: MeshMethod::SolidAngle,
+    };
 }
 
 impl LightSample {
@@ -48,6 +104,8 @@ impl LightSample {
 #[derive(Clone, Debug)]
 pub enum Light {
     Point(point::PointLight),
+    Spot(spot::SpotLight),
+    Directional(directional::DirectionalLight),
     Quad(quad::QuadLight),
     Sphere(sphere::SphereLight),
     Mesh(mesh::MeshLight),
@@ -58,6 +116,8 @@ impl Light {
     pub fn power(&self) -> f32 {
         match self {
             Light::Point(l) => l.power(),
+            Light::Spot(l) => l.power(),
+            Light::Directional(l) => l.power(),
             Light::Quad(l) => l.power(),
             Light::Sphere(l) => l.power(),
             Light::Mesh(l) => l.power(),
@@ -65,17 +125,54 @@ impl Light {
     }
 
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point(_))
+        matches!(
+            self,
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_)
+        )
     }
 
-    /// Each light's default sampler: area form for quads and meshes, the uniform cone for
-    /// spheres.
-    pub fn sample(&self, p: Vec3, u: [f32; 3]) -> Option<LightSample> {
+    /// A sample of this light seen from p, by the method `m` selects for its kind.
+    pub fn sample(&self, p: Vec3, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
+        let u2 = [u[0], u[1]];
         match self {
             Light::Point(l) => l.sample(p),
-            Light::Quad(l) => l.sample_area(p, [u[0], u[1]]),
-            Light::Sphere(l) => l.sample_cone(p, [u[0], u[1]]),
-            Light::Mesh(l) => l.sample_area(p, u),
+            Light::Spot(l) => l.sample(p),
+            Light::Directional(l) => Some(l.sample()),
+            Light::Quad(l) => match m.quad {
+                QuadMethod::Area => l.sample_area(p, u2),
+                QuadMethod::SolidAngle => l.sample_solid_angle(p, u2),
+            },
+            Light::Sphere(l) => match m.sphere {
+                SphereMethod::Area => l.sample_area(p, u2),
+                SphereMethod::Cap => l.sample_cap(p, u2),
+                SphereMethod::Cone => l.sample_cone(p, u2),
+            },
+            Light::Mesh(l) => match m.mesh {
+                MeshMethod::Area => l.sample_area(p, u),
+                MeshMethod::SolidAngle => l.sample_solid_angle(p, u),
+            },
+        }
+    }
+
+    /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction from p
+    /// to the point q on this light (triangle `local` for a mesh). 0 for delta lights: no
+    /// direction found by another strategy can reach them.
+    pub fn pdf(&self, p: Vec3, q: Vec3, local: u32, m: &LightMethods) -> f32 {
+        match self {
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_) => 0.0,
+            Light::Quad(l) => match m.quad {
+                QuadMethod::Area => l.pdf_area(p, q),
+                QuadMethod::SolidAngle => l.pdf_solid_angle(p, q),
+            },
+            Light::Sphere(l) => match m.sphere {
+                SphereMethod::Area => l.pdf_area(p, q),
+                SphereMethod::Cap => l.pdf_cap(p, q),
+                SphereMethod::Cone => l.pdf_cone(p, q),
+            },
+            Light::Mesh(l) => match m.mesh {
+                MeshMethod::Area => l.pdf_area(p, q, local as usize),
+                MeshMethod::SolidAngle => l.pdf_solid_angle(p, q, local as usize),
+            },
         }
     }
 
@@ -84,7 +181,7 @@ impl Light {
     /// two-sided for spheres (see docs/conventions.md).
     pub fn emitted(&self, n: Vec3, w: Vec3) -> Vec3 {
         match self {
-            Light::Point(_) => Vec3::ZERO,
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_) => Vec3::ZERO,
             Light::Quad(l) => {
                 if n.dot(w) > 0.0 {
                     l.radiance

@@ -30,6 +30,7 @@ impl PointLight {
             normal: Vec3::ZERO,
             radiance: self.intensity / d2,
             pdf: 1.0,
+            distant: false,
         })
     }
 }

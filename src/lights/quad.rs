@@ -4,6 +4,7 @@
 
 use super::LightSample;
 use crate::math::luminance;
+use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -52,6 +53,7 @@ impl QuadLight {
             normal: self.normal,
             radiance: self.radiance,
             pdf: d2 / (self.area * cos_l),
+            distant: false,
         })
     }
 
@@ -65,5 +67,63 @@ impl QuadLight {
         } else {
             0.0
         }
+    }
+}
+
+impl QuadLight {
+    /// The spherical rectangle seen from p, or None when p is behind the emitting side or in
+    /// the plane (no radiance reaches p) or the solid angle is below
+    /// [`MIN_SOLID_ANGLE`](crate::sampling::spherical::MIN_SOLID_ANGLE) (area sampling then).
+    fn spherical_rect(&self, p: Vec3) -> Option<SphericalRectangle> {
+        let corner = (self.corner - p).as_dvec3();
+        if corner.dot(self.normal.as_dvec3()) >= 0.0 {
+            return None;
+        }
+        SphericalRectangle::new(corner, self.edge_u.as_dvec3(), self.edge_v.as_dvec3())
+            .filter(|r| r.area() >= MIN_SOLID_ANGLE)
+    }
+
+    /// p sees the emitting side.
+    fn faces(&self, p: Vec3) -> bool {
+        (p - self.corner).dot(self.normal) > 0.0
+    }
+
+    /// Uniform in the solid angle of the quad (Ureña, Fajardo, King 2013): pdf 1/Ω. Falls back
+    /// to area sampling for tiny solid angles; [`Self::pdf_solid_angle`] makes the same choice.
+    /// Needs orthogonal edges (checked when the scene is prepared).
+    pub fn sample_solid_angle(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        if !self.faces(p) {
+            return None;
+        }
+        let Some(rect) = self.spherical_rect(p) else {
+            return self.sample_area(p, u);
+        };
+        let d = rect.sample([u[0] as f64, u[1] as f64]);
+        let dist = d.length();
+        let wi = (d / dist).as_vec3();
+        let point = p + d.as_vec3();
+        Some(LightSample {
+            wi,
+            point,
+            normal: self.normal,
+            radiance: self.radiance,
+            pdf: (1.0 / rect.area()) as f32,
+            distant: false,
+        })
+    }
+
+    pub fn pdf_solid_angle(&self, p: Vec3, q: Vec3) -> f32 {
+        if !self.faces(p) {
+            return 0.0;
+        }
+        match self.spherical_rect(p) {
+            Some(rect) => (1.0 / rect.area()) as f32,
+            None => self.pdf_area(p, q),
+        }
+    }
+
+    /// Spherical-rectangle sampling assumes a rectangle, not a general parallelogram.
+    pub fn is_rectangle(&self) -> bool {
+        self.edge_u.dot(self.edge_v).abs() <= 1e-5 * self.edge_u.length() * self.edge_v.length()
     }
 }

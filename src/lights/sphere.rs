@@ -61,6 +61,7 @@ impl SphereLight {
             normal,
             radiance: self.radiance,
             pdf: uniform_cone_pdf(omc_max),
+            distant: false,
         })
     }
 
@@ -119,6 +120,100 @@ impl SphereLight {
             normal: -n,
             radiance: self.radiance,
             pdf: area_pdf * dist2 / cos_l,
+            distant: false,
         })
+    }
+}
+
+impl SphereLight {
+    fn area(&self) -> f32 {
+        4.0 * PI * self.radius * self.radius
+    }
+
+    /// Uniform over the whole sphere by area: pdf_ω = d²/(A |cos θ_l|). From outside, a sample
+    /// on the far side is hidden by the sphere itself: None (it carries no radiance), so about
+    /// half the samples are wasted — the lecture's point about this method.
+    pub fn sample_area(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        let outside = (p - self.center).length_squared() > self.radius * self.radius;
+        if !outside {
+            return self.sample_area_inside(p, u);
+        }
+        let n = sample_uniform_sphere(u);
+        let point = self.center + n * self.radius;
+        let d = point - p;
+        let dist2 = d.length_squared();
+        let wi = d / dist2.sqrt();
+        let cos_l = -n.dot(wi);
+        if cos_l <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            point,
+            normal: n,
+            radiance: self.radiance,
+            pdf: dist2 / (self.area() * cos_l),
+            distant: false,
+        })
+    }
+
+    /// pdf of [`Self::sample_area`] for light point q (visible from p).
+    pub fn pdf_area(&self, p: Vec3, q: Vec3) -> f32 {
+        let d = q - p;
+        let dist2 = d.length_squared();
+        let cos_l = ((q - self.center) / self.radius).dot(d).abs() / dist2.sqrt();
+        if cos_l > 0.0 {
+            dist2 / (self.area() * cos_l)
+        } else {
+            0.0
+        }
+    }
+
+    /// Uniform by area over the cap visible from p: the points whose angle α from the axis
+    /// centre→p has cos α ≥ r/d, of area 2πr²(1 - r/d); uniform in cos α by Archimedes'
+    /// hat-box theorem. From inside the sphere, uniform over the whole sphere.
+    pub fn sample_cap(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        let to_p = p - self.center;
+        let dc = to_p.length();
+        if dc <= self.radius {
+            return self.sample_area_inside(p, u);
+        }
+        let cap = 1.0 - self.radius / dc; // 1 - cos α_max
+        let n = Frame::from_normal(to_p / dc).to_world(sample_uniform_cone(u, cap));
+        let point = self.center + n * self.radius;
+        let d = point - p;
+        let dist2 = d.length_squared();
+        let wi = d / dist2.sqrt();
+        let cos_l = -n.dot(wi);
+        if cos_l <= 0.0 {
+            return None; // the cap's rim, tangent to the line of sight (measure zero)
+        }
+        let cap_area = 2.0 * PI * self.radius * self.radius * cap;
+        Some(LightSample {
+            wi,
+            point,
+            normal: n,
+            radiance: self.radiance,
+            pdf: dist2 / (cap_area * cos_l),
+            distant: false,
+        })
+    }
+
+    /// pdf of [`Self::sample_cap`] for light point q visible from p.
+    pub fn pdf_cap(&self, p: Vec3, q: Vec3) -> f32 {
+        let to_p = p - self.center;
+        let dc = to_p.length();
+        if dc <= self.radius {
+            return self.pdf_area_inside(p, q);
+        }
+        let n = (q - self.center) / self.radius;
+        let d = q - p;
+        let dist2 = d.length_squared();
+        let cos_l = -n.dot(d) / dist2.sqrt();
+        if cos_l <= 0.0 {
+            return 0.0;
+        }
+        let cap_area = 2.0 * PI * self.radius * self.radius * (1.0 - self.radius / dc);
+        dist2 / (cap_area * cos_l)
     }
 }

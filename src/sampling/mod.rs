@@ -2,5 +2,6 @@
 //! `util/sampling.h`), discrete distributions and the per-pixel random streams.
 
 pub mod discrete;
+pub mod spherical;
 pub mod stream;
 pub mod warp;

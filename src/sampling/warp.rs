@@ -77,3 +77,157 @@ pub fn sample_uniform_triangle(u: [f32; 2]) -> (f32, f32) {
     }
     (b1, 1.0 - b0 - b1)
 }
+
+/// Uniform direction on the hemisphere about +z.
+pub fn sample_uniform_hemisphere(u: [f32; 2]) -> Vec3 {
+    let z = 1.0 - u[0];
+    // 1 - z² = u(2 - u): no cancellation near the pole.
+    let r = (u[0] * (2.0 - u[0])).sqrt();
+    let phi = 2.0 * PI * u[1];
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+pub const UNIFORM_HEMISPHERE_PDF: f32 = 1.0 / (2.0 * PI);
+
+/// Phong lobe about +z, pdf (n+1)/(2π)·cos^n α, by cos α = u^(1/(n+1)) (Lafortune & Willems
+/// 1994). Written with expm1 so that huge exponents neither collapse the lobe to the axis nor
+/// produce NaN: 1 - cos α = -expm1(ln u/(n+1)), sin²α = -expm1(2 ln u/(n+1)).
+/// The lecture's pair — pdf (n+2)/(2π) cos^n with cos α = u^(1/(n+2)) — is inconsistent:
+/// see docs/lecture-errata.md.
+pub fn sample_phong_lobe(u: [f32; 2], exponent: f32) -> Vec3 {
+    let l = (1.0 - u[0]).ln() / (exponent + 1.0); // 1 - u keeps u = 0 at the pole, not ln 0
+    let one_minus_cos = -l.exp_m1();
+    let sin2 = -(2.0 * l).exp_m1();
+    let sin = sin2.max(0.0).sqrt();
+    let phi = 2.0 * PI * u[1];
+    Vec3::new(sin * phi.cos(), sin * phi.sin(), 1.0 - one_minus_cos)
+}
+
+/// Solid-angle pdf of [`sample_phong_lobe`] for a direction whose angle to the lobe axis has
+/// 1 - cos α = `one_minus_cos` (pass the chordal form |a - b|²/2 for precision near the axis).
+pub fn phong_lobe_pdf(one_minus_cos: f32, exponent: f32) -> f32 {
+    if one_minus_cos >= 1.0 {
+        return 0.0; // the lobe's back hemisphere
+    }
+    (exponent + 1.0) * (0.5 * FRAC_1_PI) * (exponent * (-one_minus_cos).ln_1p()).exp()
+}
+
+/// Inverse of [`sample_uniform_cone`] for a direction inside the cone.
+pub fn invert_uniform_cone(w: Vec3, one_minus_cos_max: f32) -> [f32; 2] {
+    let one_minus_cos = (w.x * w.x + w.y * w.y) / (1.0 + w.z);
+    [one_minus_cos / one_minus_cos_max, wrap_phi(w.y.atan2(w.x))]
+}
+
+/// Inverse of [`sample_cosine_hemisphere`] (the inverse concentric map of Shirley & Chiu).
+pub fn invert_cosine_hemisphere(w: Vec3) -> [f32; 2] {
+    let (x, y) = (w.x, w.y);
+    let r = (x * x + y * y).sqrt();
+    let phi = y.atan2(x);
+    // Back to the square by the quadrant the concentric map sent it to.
+    let (a, b) = if (-FRAC_PI_4..=FRAC_PI_4).contains(&phi)
+        || phi >= 3.0 * FRAC_PI_4
+        || phi <= -3.0 * FRAC_PI_4
+    {
+        let sign = if x >= 0.0 { 1.0 } else { -1.0 };
+        let a = sign * r;
+        let t = if x >= 0.0 {
+            phi
+        } else if phi > 0.0 {
+            phi - PI
+        } else {
+            phi + PI
+        };
+        (a, a * t / FRAC_PI_4)
+    } else {
+        let sign = if y >= 0.0 { 1.0 } else { -1.0 };
+        let b = sign * r;
+        let t = if y >= 0.0 {
+            FRAC_PI_2 - phi
+        } else {
+            -FRAC_PI_2 - phi
+        };
+        (b * t / FRAC_PI_4, b)
+    };
+    [0.5 * (a + 1.0), 0.5 * (b + 1.0)]
+}
+
+/// Inverse of [`sample_phong_lobe`].
+pub fn invert_phong_lobe(w: Vec3, exponent: f32) -> [f32; 2] {
+    let one_minus_cos = (w.x * w.x + w.y * w.y) / (1.0 + w.z);
+    // 1 - u = cos^(n+1) α
+    [
+        -((exponent + 1.0) * (-one_minus_cos).ln_1p()).exp_m1(),
+        wrap_phi(w.y.atan2(w.x)),
+    ]
+}
+
+fn wrap_phi(phi: f32) -> f32 {
+    let t = phi / (2.0 * PI);
+    if t < 0.0 { t + 1.0 } else { t }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid() -> impl Iterator<Item = [f32; 2]> {
+        (0..10).flat_map(|i| {
+            (0..10).map(move |j| {
+                [
+                    1e-4 + (1.0 - 2e-4) * i as f32 / 9.0,
+                    1e-4 + (1.0 - 2e-4) * j as f32 / 9.0,
+                ]
+            })
+        })
+    }
+
+    #[test]
+    fn inverses_round_trip() {
+        for u in grid() {
+            let c = invert_cosine_hemisphere(sample_cosine_hemisphere(u));
+            assert!(
+                (c[0] - u[0]).abs() < 1e-4 && (c[1] - u[1]).abs() < 1e-4,
+                "cosine {u:?} -> {c:?}"
+            );
+            for omc in [1.0, 0.3, 1e-6] {
+                let c = invert_uniform_cone(sample_uniform_cone(u, omc), omc);
+                assert!(
+                    (c[0] - u[0]).abs() < 1e-3 && (c[1] - u[1]).abs() < 1e-4,
+                    "cone {omc}: {u:?} -> {c:?}"
+                );
+            }
+            for n in [0.0, 1.0, 100.0, 1e4] {
+                let c = invert_phong_lobe(sample_phong_lobe(u, n), n);
+                assert!(
+                    (c[0] - u[0]).abs() < 2e-3 && (c[1] - u[1]).abs() < 1e-4,
+                    "phong {n}: {u:?} -> {c:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn extreme_inputs_stay_finite_and_unit() {
+        for u in [
+            [0.0, 0.0],
+            [super::super::stream::ONE_MINUS_EPSILON; 2],
+            [0.5, 0.0],
+        ] {
+            for w in [
+                sample_cosine_hemisphere(u),
+                sample_uniform_hemisphere(u),
+                sample_uniform_sphere(u),
+                sample_uniform_cone(u, 1e-12),
+                sample_phong_lobe(u, 0.0),
+                sample_phong_lobe(u, 1e6),
+            ] {
+                assert!(
+                    w.is_finite() && (w.length() - 1.0).abs() < 1e-5,
+                    "{u:?} -> {w}"
+                );
+            }
+        }
+        assert!(phong_lobe_pdf(0.0, 1e6).is_finite());
+        assert_eq!(phong_lobe_pdf(1.0, 3.0), 0.0);
+    }
+}

@@ -19,6 +19,12 @@ pub struct SceneFile {
     pub spheres: Vec<SphereDesc>,
     #[serde(default, rename = "point_light")]
     pub point_lights: Vec<PointLightDesc>,
+    #[serde(default, rename = "spot_light")]
+    pub spot_lights: Vec<SpotLightDesc>,
+    #[serde(default, rename = "directional_light")]
+    pub directional_lights: Vec<DirectionalLightDesc>,
+    /// Present: the scene also has the ambient-occlusion integrand (`ao-*` strategies).
+    pub ambient_occlusion: Option<AmbientOcclusionDesc>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -47,8 +53,14 @@ pub struct ImageDesc {
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
     pub name: String,
-    /// Lambertian reflectance in [0, 1] per channel.
+    /// Diffuse (Lambertian) reflectance kd per channel.
+    #[serde(default)]
     pub albedo: [f32; 3],
+    /// Glossy reflectance ks of a normalized Phong lobe; kd + ks ≤ 1 per channel.
+    #[serde(default)]
+    pub specular: [f32; 3],
+    /// Phong exponent n ≥ 0 (required when `specular` is non-zero).
+    pub exponent: Option<f32>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -116,6 +128,41 @@ pub struct SphereDesc {
 #[serde(deny_unknown_fields)]
 pub struct PointLightDesc {
     pub position: [f32; 3],
-    /// Radiant power Φ [W] per channel; the intensity is Φ/(4π) [W/sr].
-    pub power: [f32; 3],
+    /// Radiant power Φ [W] per channel; the intensity is Φ/(4π) [W/sr]. Give this or
+    /// `intensity`, not both.
+    pub power: Option<[f32; 3]>,
+    /// Radiant intensity I [W/sr] per channel.
+    pub intensity: Option<[f32; 3]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotLightDesc {
+    pub position: [f32; 3],
+    /// The direction the spot points in (its axis).
+    pub direction: [f32; 3],
+    /// Half-angle of the lit cone, degrees in [0, 180].
+    pub cone_angle_deg: f32,
+    /// Half-angle where the smoothstep falloff starts, degrees in [0, cone_angle_deg]
+    /// (default: cone_angle_deg, a hard edge).
+    pub falloff_start_deg: Option<f32>,
+    /// Power Φ [W] or on-axis intensity I [W/sr]; one of the two.
+    pub power: Option<[f32; 3]>,
+    pub intensity: Option<[f32; 3]>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DirectionalLightDesc {
+    /// The direction the light travels in (from the light towards the scene).
+    pub direction: [f32; 3],
+    /// Irradiance E⊥ [W/m²] on a surface facing the light.
+    pub irradiance: [f32; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AmbientOcclusionDesc {
+    /// Occluders farther than this do not count.
+    pub distance: f32,
 }

@@ -25,6 +25,10 @@ pub struct Scene {
     pub quads: Vec<Quad>,
     pub spheres: Vec<SphereShape>,
     pub point_lights: Vec<PointLight>,
+    pub spot_lights: Vec<SpotLight>,
+    pub directional_lights: Vec<DirectionalLight>,
+    /// Occlusion distance of the ambient-occlusion integrand, when the scene asks for it.
+    pub ao_distance: Option<f32>,
 }
 
 /// Pinhole camera, right-handed: `forward` = normalize(look_at - eye), `right` = forward × up.
@@ -38,10 +42,13 @@ pub struct Camera {
     pub tan_half_fov_y: f32,
 }
 
+/// Diffuse kd plus normalized-Phong ks with exponent (see `bsdf`).
 #[derive(Clone, Debug)]
 pub struct Material {
     pub name: String,
     pub albedo: Vec3,
+    pub specular: Vec3,
+    pub exponent: f32,
 }
 
 #[derive(Clone, Debug)]
@@ -77,6 +84,24 @@ pub struct PointLight {
     pub intensity: Vec3,
 }
 
+#[derive(Clone, Copy, Debug)]
+pub struct SpotLight {
+    pub position: Vec3,
+    /// Unit axis.
+    pub direction: Vec3,
+    /// On-axis intensity [W/sr].
+    pub intensity: Vec3,
+    pub cos_cone: f32,
+    pub cos_falloff_start: f32,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionalLight {
+    /// Unit direction the light travels in.
+    pub direction: Vec3,
+    pub irradiance: Vec3,
+}
+
 impl Scene {
     pub fn has_emitters(&self) -> bool {
         self.meshes.iter().any(|m| m.emission.is_some())
@@ -86,6 +111,8 @@ impl Scene {
 
     pub fn has_delta_lights(&self) -> bool {
         !self.point_lights.is_empty()
+            || !self.spot_lights.is_empty()
+            || !self.directional_lights.is_empty()
     }
 
     pub fn pixel_count(&self) -> usize {
@@ -173,13 +200,34 @@ impl Scene {
 
         let mut materials = Vec::new();
         for (i, m) in desc.materials.iter().enumerate() {
-            let field = format!("material[{i}].albedo");
-            let albedo = v.vec3(&field, m.albedo)?;
-            if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
+            let albedo = v.vec3(&format!("material[{i}].albedo"), m.albedo)?;
+            let specular = v.vec3(&format!("material[{i}].specular"), m.specular)?;
+            if albedo.min_element() < 0.0
+                || specular.min_element() < 0.0
+                || (albedo + specular).max_element() > 1.0
+            {
                 return Err(Error::field(
                     path,
-                    field,
-                    "albedo must be in [0, 1] (energy conservation)",
+                    format!("material[{i}]"),
+                    "albedo and specular must be non-negative with albedo + specular ≤ 1 per channel (energy conservation)",
+                ));
+            }
+            let exponent = match m.exponent {
+                Some(e) => v.finite(&format!("material[{i}].exponent"), e)?,
+                None if specular != Vec3::ZERO => {
+                    return Err(Error::field(
+                        path,
+                        format!("material[{i}].exponent"),
+                        "required when `specular` is non-zero",
+                    ));
+                }
+                None => 0.0,
+            };
+            if exponent < 0.0 {
+                return Err(Error::field(
+                    path,
+                    format!("material[{i}].exponent"),
+                    "must be ≥ 0",
                 ));
             }
             if materials.iter().any(|x: &Material| x.name == m.name) {
@@ -192,6 +240,8 @@ impl Scene {
             materials.push(Material {
                 name: m.name.clone(),
                 albedo,
+                specular,
+                exponent,
             });
         }
         let material = |field: String, name: &str| -> Result<u32> {
@@ -285,19 +335,83 @@ impl Scene {
 
         let mut point_lights = Vec::new();
         for (i, l) in desc.point_lights.iter().enumerate() {
-            let power = v.vec3(&format!("point_light[{i}].power"), l.power)?;
-            if power.min_element() < 0.0 {
+            let f = format!("point_light[{i}]");
+            // Isotropic: Φ = 4π I.
+            let intensity =
+                v.power_or_intensity(&f, l.power, l.intensity, 4.0 * std::f32::consts::PI)?;
+            point_lights.push(PointLight {
+                position: v.vec3(&format!("{f}.position"), l.position)?,
+                intensity,
+            });
+        }
+        let mut spot_lights = Vec::new();
+        for (i, l) in desc.spot_lights.iter().enumerate() {
+            let f = format!("spot_light[{i}]");
+            let cone = v.finite(&format!("{f}.cone_angle_deg"), l.cone_angle_deg)?;
+            if !(0.0..=180.0).contains(&cone) {
                 return Err(Error::field(
                     path,
-                    format!("point_light[{i}].power"),
+                    format!("{f}.cone_angle_deg"),
+                    format!("must be in [0, 180], got {cone}"),
+                ));
+            }
+            let start = v.finite(
+                &format!("{f}.falloff_start_deg"),
+                l.falloff_start_deg.unwrap_or(cone),
+            )?;
+            if !(0.0..=cone).contains(&start) {
+                return Err(Error::field(
+                    path,
+                    format!("{f}.falloff_start_deg"),
+                    format!("must be in [0, cone_angle_deg = {cone}], got {start}"),
+                ));
+            }
+            let (cos_cone, cos_falloff_start) = (cone.to_radians().cos(), start.to_radians().cos());
+            // Φ/I of a smoothstep spot (pbrt-v4 SpotLight::Phi): 2π [(1 - cos θs) + (cos θs - cos θe)/2].
+            let solid = 2.0
+                * std::f32::consts::PI
+                * ((1.0 - cos_falloff_start) + 0.5 * (cos_falloff_start - cos_cone));
+            let intensity = v.power_or_intensity(&f, l.power, l.intensity, solid)?;
+            let direction = v.unit(&format!("{f}.direction"), l.direction)?;
+            let position = v.vec3(&format!("{f}.position"), l.position)?;
+            spot_lights.push(SpotLight {
+                position,
+                direction,
+                intensity,
+                cos_cone,
+                cos_falloff_start,
+            });
+        }
+        let mut directional_lights = Vec::new();
+        for (i, l) in desc.directional_lights.iter().enumerate() {
+            let f = format!("directional_light[{i}]");
+            let irradiance = v.vec3(&format!("{f}.irradiance"), l.irradiance)?;
+            if irradiance.min_element() < 0.0 {
+                return Err(Error::field(
+                    path,
+                    format!("{f}.irradiance"),
                     "must be non-negative",
                 ));
             }
-            point_lights.push(PointLight {
-                position: v.vec3(&format!("point_light[{i}].position"), l.position)?,
-                intensity: power / (4.0 * std::f32::consts::PI),
+            directional_lights.push(DirectionalLight {
+                direction: v.unit(&format!("{f}.direction"), l.direction)?,
+                irradiance,
             });
         }
+        let ao_distance = match &desc.ambient_occlusion {
+            None => None,
+            Some(ao) => {
+                let d = v.finite("ambient_occlusion.distance", ao.distance)?;
+                if d <= 0.0 {
+                    return Err(Error::field(
+                        path,
+                        "ambient_occlusion.distance",
+                        "must be positive",
+                    ));
+                }
+                Some(d)
+            }
+        };
 
         let scene = Scene {
             name: path
@@ -314,6 +428,9 @@ impl Scene {
             quads,
             spheres,
             point_lights,
+            spot_lights,
+            directional_lights,
+            ao_distance,
         };
         if !scene.has_emitters() && !scene.has_delta_lights() {
             return Err(Error::field(
@@ -366,6 +483,60 @@ impl Validator<'_> {
             ));
         }
         Ok(Some(e))
+    }
+
+    fn unit(&self, field: &str, a: [f32; 3]) -> Result<Vec3> {
+        let d = self.vec3(field, a)?.normalize_or_zero();
+        if d == Vec3::ZERO {
+            return Err(Error::field(
+                self.path,
+                field,
+                "must be a non-zero direction",
+            ));
+        }
+        Ok(d)
+    }
+
+    /// Intensity from exactly one of `power` (divided by the light's solid-angle factor) or
+    /// `intensity`.
+    fn power_or_intensity(
+        &self,
+        light: &str,
+        power: Option<[f32; 3]>,
+        intensity: Option<[f32; 3]>,
+        solid_angle: f32,
+    ) -> Result<Vec3> {
+        let (field, value) = match (power, intensity) {
+            (Some(p), None) => (
+                format!("{light}.power"),
+                self.vec3(&format!("{light}.power"), p)?,
+            ),
+            (None, Some(i)) => (
+                format!("{light}.intensity"),
+                self.vec3(&format!("{light}.intensity"), i)?,
+            ),
+            _ => {
+                return Err(Error::field(
+                    self.path,
+                    light,
+                    "give exactly one of `power` and `intensity`",
+                ));
+            }
+        };
+        if value.min_element() < 0.0 {
+            return Err(Error::field(self.path, field, "must be non-negative"));
+        }
+        if power.is_some() {
+            if solid_angle <= 0.0 {
+                return Err(Error::field(
+                    self.path,
+                    field,
+                    "a light with an empty cone has no power to distribute: give `intensity`",
+                ));
+            }
+            return Ok(value / solid_angle);
+        }
+        Ok(value)
     }
 
     fn camera(&self, c: &file::CameraDesc) -> Result<Camera> {

@@ -3,12 +3,18 @@
 
 use super::{Probes, ShadingPoint, Strategy};
 use crate::prepare::PreparedScene;
+use crate::render::emission_contribution;
 use crate::sampling::stream::{SampleStream, name_id};
 use crate::stats::Welford;
 use glam::Vec3;
 
 /// The radiance one sample's probes contribute, traced one ray at a time.
-pub fn probe_radiance(scene: &PreparedScene, probes: &Probes) -> Vec3 {
+pub fn probe_radiance(
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    sp: &ShadingPoint,
+    probes: &Probes,
+) -> Vec3 {
     let mut l = Vec3::ZERO;
     if let Some(s) = probes.shadow {
         if !scene.tracer.occluded(&s.ray) {
@@ -17,7 +23,7 @@ pub fn probe_radiance(scene: &PreparedScene, probes: &Probes) -> Vec3 {
     }
     if let Some(e) = probes.emission {
         if let Some(hit) = scene.tracer.intersect(&e.ray) {
-            l += e.weight * scene.emitted_at(&e.ray, &hit);
+            l += emission_contribution(scene, strategy, sp, &e, &hit);
         }
     }
     l
@@ -36,7 +42,7 @@ pub fn estimate_at(
     let id = name_id(strategy.name());
     for i in 0..samples {
         let mut rng = SampleStream::new(seed, id, u64::MAX, i);
-        let l = probe_radiance(scene, &strategy.sample(scene, sp, &mut rng));
+        let l = probe_radiance(scene, strategy, sp, &strategy.sample(scene, sp, &mut rng));
         for (c, s) in stats.iter_mut().enumerate() {
             s.add(l[c] as f64);
         }

@@ -2,13 +2,17 @@
 //! shading point into at most one shadow probe and one emission probe. The renderer traces
 //! the probes as packets; a strategy never sees the tracer.
 
-pub mod cosine_hemisphere;
+pub mod ambient_occlusion;
+pub mod direction;
 pub mod estimate;
 pub mod light_sampling;
+pub mod mis;
 
+use crate::bsdf::Bsdf;
 use crate::geometry::Ray;
+use crate::lights::{LightMethods, MeshMethod, QuadMethod, SphereMethod};
 use crate::math::offset_ray_origin;
-use crate::prepare::PreparedScene;
+use crate::prepare::{PreparedScene, SurfaceHit};
 use crate::sampling::stream::SampleStream;
 use glam::Vec3;
 
@@ -19,26 +23,28 @@ pub struct ShadingPoint {
     pub p: Vec3,
     pub origin: Vec3,
     pub n: Vec3,
-    pub albedo: Vec3,
+    /// Unit direction towards the viewer.
+    pub wo: Vec3,
+    pub bsdf: Bsdf,
 }
 
 impl ShadingPoint {
-    /// A point seen along `view_dir` (pointing at the surface): the normal is flipped to the
-    /// viewer's side and the ray origin offset along it.
-    pub fn new(p: Vec3, ng: Vec3, view_dir: Vec3, albedo: Vec3) -> Self {
+    /// A point seen along `view_dir` (unit, pointing at the surface).
+    pub fn new(p: Vec3, ng: Vec3, view_dir: Vec3, bsdf: Bsdf) -> Self {
         let n = if ng.dot(view_dir) < 0.0 { ng } else { -ng };
         ShadingPoint {
             p,
             origin: offset_ray_origin(p, n),
             n,
-            albedo,
+            wo: -view_dir,
+            bsdf,
         }
     }
 }
 
-/// What one sample asks the tracer. The contribution is
-/// `shadow.value` if the shadow segment is clear, plus `emission.weight · Le` of the emitter the
-/// emission ray hits first.
+/// What one sample asks the tracer. The contribution is `shadow.value` if the shadow segment
+/// is clear, plus `emission.weight · Le · w` for the emitter the emission ray hits first, with
+/// w the strategy's [`Strategy::emission_weight`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Probes {
     pub shadow: Option<ShadowProbe>,
@@ -55,35 +61,130 @@ pub struct ShadowProbe {
 pub struct EmissionProbe {
     pub ray: Ray,
     pub weight: Vec3,
+    /// Solid-angle pdf the direction was sampled with (for MIS).
+    pub pdf: f32,
+}
+
+/// The quantity a strategy estimates: each has its own reference image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Integrand {
+    /// Emission seen by the camera plus reflected direct illumination.
+    Direct,
+    /// (1/π)∫ V(ω) cos θ dω with occluders within the scene's AO distance.
+    AmbientOcclusion,
+}
+
+impl Integrand {
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrand::Direct => "direct",
+            Integrand::AmbientOcclusion => "ao",
+        }
+    }
 }
 
 pub trait Strategy: Send + Sync {
     fn name(&self) -> &'static str;
 
-    /// One-line description for `--help`-style listings.
+    /// One-line description for listings.
     fn describe(&self) -> &'static str;
 
-    /// Ok if the strategy is unbiased for this scene, otherwise why it does not apply.
+    /// Ok if the strategy is unbiased for this scene and adds something, otherwise why not.
     fn applies(&self, scene: &PreparedScene) -> Result<(), String>;
 
     fn sample(&self, scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes;
+
+    fn integrand(&self) -> Integrand {
+        Integrand::Direct
+    }
+
+    /// Weight of the emission an emission probe found at `hit` (MIS strategies override).
+    fn emission_weight(
+        &self,
+        _scene: &PreparedScene,
+        _sp: &ShadingPoint,
+        _probe: &EmissionProbe,
+        _hit: &SurfaceHit,
+    ) -> f32 {
+        1.0
+    }
 }
 
 /// Every strategy dibench knows, in listing order.
 pub fn registry() -> Vec<Box<dyn Strategy>> {
+    use direction::{DirectionKind, DirectionSampling};
+    use light_sampling::LightSampling;
+    let basic = LightMethods::BASIC;
     vec![
-        Box::new(light_sampling::LightSampling),
-        Box::new(cosine_hemisphere::CosineHemisphere),
+        Box::new(DirectionSampling(DirectionKind::UniformHemisphere)),
+        Box::new(DirectionSampling(DirectionKind::CosineHemisphere)),
+        Box::new(DirectionSampling(DirectionKind::Bsdf)),
+        Box::new(LightSampling::basic()),
+        Box::new(LightSampling::variant(
+            "light-quad-sa",
+            "as `light`, but quads uniform in solid angle (spherical rectangle, Ureña et al. 2013)",
+            LightMethods {
+                quad: QuadMethod::SolidAngle,
+                ..basic
+            },
+        )),
+        Box::new(LightSampling::variant(
+            "light-sphere-area",
+            "as `light`, but spheres uniform by area over the whole sphere",
+            LightMethods {
+                sphere: SphereMethod::Area,
+                ..basic
+            },
+        )),
+        Box::new(LightSampling::variant(
+            "light-sphere-cap",
+            "as `light`, but spheres uniform by area over the visible cap",
+            LightMethods {
+                sphere: SphereMethod::Cap,
+                ..basic
+            },
+        )),
+        Box::new(LightSampling::variant(
+            "light-mesh-sa",
+            "as `light`, but mesh triangles uniform in solid angle (spherical triangle, Arvo 1995)",
+            LightMethods {
+                mesh: MeshMethod::SolidAngle,
+                ..basic
+            },
+        )),
+        Box::new(mis::Mis(mis::Heuristic::Balance)),
+        Box::new(mis::Mis(mis::Heuristic::Power)),
+        Box::new(ambient_occlusion::AmbientOcclusion { cosine: false }),
+        Box::new(ambient_occlusion::AmbientOcclusion { cosine: true }),
     ]
-}
-
-/// The strategy references are rendered with: unbiased for every scene with a light.
-pub fn reference_strategy() -> Box<dyn Strategy> {
-    Box::new(light_sampling::LightSampling)
 }
 
 pub fn by_name(name: &str) -> Option<Box<dyn Strategy>> {
     registry().into_iter().find(|s| s.name() == name)
+}
+
+/// The strategy a reference for `integrand` is rendered with: the lowest-variance unbiased
+/// one that applies.
+pub fn reference_strategy(
+    scene: &PreparedScene,
+    integrand: Integrand,
+) -> Option<Box<dyn Strategy>> {
+    let order: &[&str] = match integrand {
+        Integrand::Direct => &["mis-power", "light"],
+        Integrand::AmbientOcclusion => &["ao-cosine"],
+    };
+    order
+        .iter()
+        .filter_map(|n| by_name(n))
+        .find(|s| s.applies(scene).is_ok())
+}
+
+/// The integrands a scene has (the set its references are made for).
+pub fn integrands(scene: &PreparedScene) -> Vec<Integrand> {
+    [Integrand::Direct, Integrand::AmbientOcclusion]
+        .into_iter()
+        .filter(|&i| reference_strategy(scene, i).is_some())
+        .collect()
 }
 
 /// A strategy left out of a run, and why.

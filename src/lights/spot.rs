@@ -1,0 +1,59 @@
+//! Spot light: a point light whose intensity falls off with the angle θ to its axis,
+//! I(θ) = I₀ · smoothstep(cos θe, cos θs, cos θ) — full inside the falloff-start cone θs, zero
+//! outside the cone θe, Hermite smoothstep in cos θ between (pbrt-v4 `SpotLight::I`). With
+//! θs = θe the edge is hard.
+
+use super::LightSample;
+use crate::math::luminance;
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug)]
+pub struct SpotLight {
+    pub position: Vec3,
+    pub axis: Vec3,
+    pub intensity: Vec3,
+    pub cos_cone: f32,
+    pub cos_falloff_start: f32,
+}
+
+impl SpotLight {
+    pub fn falloff(&self, cos_theta: f32) -> f32 {
+        if cos_theta >= self.cos_falloff_start {
+            return if cos_theta >= self.cos_cone { 1.0 } else { 0.0 }; // θs = θe = 0: only the axis
+        }
+        if cos_theta <= self.cos_cone {
+            return 0.0;
+        }
+        let t = (cos_theta - self.cos_cone) / (self.cos_falloff_start - self.cos_cone);
+        t * t * (3.0 - 2.0 * t)
+    }
+
+    /// Φ = 2π I₀ [(1 - cos θs) + (cos θs - cos θe)/2]: the smoothstep integrates to half its
+    /// interval.
+    pub fn power(&self) -> f32 {
+        2.0 * std::f32::consts::PI
+            * ((1.0 - self.cos_falloff_start) + 0.5 * (self.cos_falloff_start - self.cos_cone))
+            * luminance(self.intensity)
+    }
+
+    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+        let d = self.position - p;
+        let d2 = d.length_squared();
+        if d2 == 0.0 {
+            return None;
+        }
+        let wi = d / d2.sqrt();
+        let falloff = self.falloff(-wi.dot(self.axis));
+        if falloff == 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            point: self.position,
+            normal: Vec3::ZERO,
+            radiance: self.intensity * (falloff / d2),
+            pdf: 1.0,
+            distant: false,
+        })
+    }
+}
