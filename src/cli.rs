@@ -25,6 +25,8 @@ pub enum Command {
     Compare(CompareArgs),
     /// Render a high-sample reference image (EXR + JSON metadata) for later comparisons.
     Reference(ReferenceArgs),
+    /// χ²-test one registered sampler: histogram vs integrated pdf, p-value, optional PNG.
+    Warp(WarpArgs),
     /// List the strategies, and which apply to a scene.
     Strategies {
         /// Scene file or name under scenes/.
@@ -64,6 +66,39 @@ pub struct CompareArgs {
 }
 
 #[derive(Args, Debug)]
+pub struct WarpArgs {
+    /// Registered sampler name (see --list).
+    pub name: Option<String>,
+    /// List every registered sampler with its parameters.
+    #[arg(long)]
+    pub list: bool,
+    /// Override a parameter, e.g. --param n=1000 (repeatable).
+    #[arg(long = "param", value_parser = parse_param)]
+    pub params: Vec<(String, f64)>,
+    /// Number of samples.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub samples: u64,
+    /// Significance level of the test.
+    #[arg(long, default_value_t = 0.01)]
+    pub alpha: f64,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write the observed histogram beside the expected counts as a PNG.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+}
+
+fn parse_param(s: &str) -> std::result::Result<(String, f64), String> {
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected KEY=VALUE, got `{s}`"))?;
+    let v: f64 = v
+        .parse()
+        .map_err(|_| format!("parameter `{k}`: `{v}` is not a number"))?;
+    Ok((k.to_string(), v))
+}
+
+#[derive(Args, Debug)]
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub common: Common,
@@ -98,6 +133,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Compare(a) => run_compare(a),
         Command::Reference(a) => run_reference(a),
         Command::Strategies { scene } => run_strategies(scene),
+        Command::Warp(a) => run_warp(a),
     }
 }
 
@@ -251,5 +287,69 @@ fn run_strategies(scene: Option<String>) -> Result<()> {
         };
         println!("{:<18} {}{status}", s.name(), s.describe());
     }
+    Ok(())
+}
+
+fn run_warp(a: WarpArgs) -> Result<()> {
+    use crate::chi2::registry::{by_name, registry};
+    if a.list || a.name.is_none() {
+        for e in registry() {
+            let params: Vec<String> = e.params.iter().map(|(k, v)| format!("{k}={v}")).collect();
+            println!(
+                "{:<20} {}{}  [{}]",
+                e.name,
+                e.describe,
+                if e.expect_fail {
+                    " (expected to fail)"
+                } else {
+                    ""
+                },
+                params.join(", ")
+            );
+        }
+        return Ok(());
+    }
+    let name = a.name.unwrap_or_default();
+    let entry = by_name(&name).ok_or_else(|| {
+        let known: Vec<_> = registry().iter().map(|e| e.name).collect();
+        Error::Usage(format!(
+            "unknown sampler `{name}` (known: {})",
+            known.join(", ")
+        ))
+    })?;
+    if a.samples == 0 {
+        return Err(Error::Usage("--samples must be at least 1".into()));
+    }
+    if !(a.alpha > 0.0 && a.alpha < 1.0) {
+        return Err(Error::Usage(format!(
+            "--alpha must be in (0, 1), got {}",
+            a.alpha
+        )));
+    }
+    let params = entry.params(&a.params).map_err(Error::Usage)?;
+    let case =
+        (entry.build)(&params).map_err(|e| Error::Usage(format!("sampler `{name}`: {e}")))?;
+    let r = crate::chi2::run(&case, a.samples, 40, 80, a.seed);
+    if let Some(png) = &a.png {
+        crate::chi2::image::write_png(png, &r.histogram)?;
+        println!(
+            "histogram (left) and expected counts (right): {}",
+            png.display()
+        );
+    }
+    println!(
+        "{}: χ² = {:.1}, dof = {}, p = {:.4e} ({} samples)",
+        r.label, r.chi2, r.dof, r.p_value, r.samples
+    );
+    if let Some(f) = &r.hard_failure {
+        return Err(Error::Usage(format!("{}: FAILED: {f}", r.label)));
+    }
+    if r.p_value < a.alpha {
+        return Err(Error::Usage(format!(
+            "{}: FAILED: p = {:.3e} < alpha = {}",
+            r.label, r.p_value, a.alpha
+        )));
+    }
+    println!("{}: passed at alpha = {}", r.label, a.alpha);
     Ok(())
 }

@@ -5,6 +5,7 @@
 //! by [`harness`].
 
 pub mod bsdf;
+pub mod chi2;
 pub mod cli;
 pub mod closed_form;
 pub mod error;

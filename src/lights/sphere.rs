@@ -158,10 +158,14 @@ impl SphereLight {
     }
 
     /// pdf of [`Self::sample_area`] for light point q (visible from p).
+    /// From outside, a point on the far side has pdf 0: the sampler never returns it.
     pub fn pdf_area(&self, p: Vec3, q: Vec3) -> f32 {
+        if (p - self.center).length_squared() <= self.radius * self.radius {
+            return self.pdf_area_inside(p, q);
+        }
         let d = q - p;
         let dist2 = d.length_squared();
-        let cos_l = ((q - self.center) / self.radius).dot(d).abs() / dist2.sqrt();
+        let cos_l = -((q - self.center) / self.radius).dot(d) / dist2.sqrt();
         if cos_l > 0.0 {
             dist2 / (self.area() * cos_l)
         } else {
