@@ -139,7 +139,7 @@ impl Subject {
 
     /// Traces a set; the obvhs baseline goes one ray at a time (the trait's lane loop).
     /// Returns a checksum so the work cannot be optimised away.
-    fn trace(&self, set: &RaySet, threads: usize) -> u64 {
+    pub fn trace(&self, set: &RaySet, threads: usize) -> u64 {
         let one = |(p, &m): (&RayPacket, &LaneMask)| -> u64 {
             match set.query {
                 Query::Closest => {

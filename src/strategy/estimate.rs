@@ -10,15 +10,15 @@ use glam::Vec3;
 /// The radiance one sample's probes contribute, traced one ray at a time.
 pub fn probe_radiance(scene: &PreparedScene, probes: &Probes) -> Vec3 {
     let mut l = Vec3::ZERO;
-    if let Some(s) = probes.shadow {
-        if !scene.tracer.occluded(&s.ray) {
-            l += s.value;
-        }
+    if let Some(s) = probes.shadow
+        && !scene.tracer.occluded(&s.ray)
+    {
+        l += s.value;
     }
-    if let Some(e) = probes.emission {
-        if let Some(hit) = scene.tracer.intersect(&e.ray) {
-            l += e.weight * scene.emitted_at(&e.ray, &hit);
-        }
+    if let Some(e) = probes.emission
+        && let Some(hit) = scene.tracer.intersect(&e.ray)
+    {
+        l += e.weight * scene.emitted_at(&e.ray, &hit);
     }
     l
 }

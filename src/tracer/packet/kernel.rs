@@ -264,11 +264,11 @@ impl Kernel for Closest<'_> {
             }
             tv = L::load(&best_t);
         }
-        for l in 0..WIDTH {
-            hits.t[l] = if hits.prim[l] == crate::tracer::NO_HIT {
+        for ((t, &p), &b) in hits.t.iter_mut().zip(&hits.prim).zip(&best_t) {
+            *t = if p == crate::tracer::NO_HIT {
                 f32::INFINITY
             } else {
-                best_t[l]
+                b
             };
         }
     }
