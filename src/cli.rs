@@ -1,10 +1,13 @@
 //! The `dibench` command line.
 
 use crate::error::{Error, Result};
-use crate::harness::{compare, reference};
+use crate::harness::{compare, rays, reference};
 use crate::prepare::PreparedScene;
 use crate::scene::Scene;
+use crate::simd::Isa;
 use crate::strategy;
+use crate::tracer::bvh::ObvhsTracer;
+use crate::tracer::packet::PacketTracer;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -27,6 +30,8 @@ pub enum Command {
     Reference(ReferenceArgs),
     /// χ²-test one registered sampler: histogram vs integrated pdf, p-value, optional PNG.
     Warp(WarpArgs),
+    /// Ray throughput of each backend (and ISA) on fixed ray sets; writes <out>/<scene>/rays.csv.
+    Rays(RaysArgs),
     /// List the strategies, and which apply to a scene.
     Strategies {
         /// Scene file or name under scenes/.
@@ -48,6 +53,13 @@ pub struct Common {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Tracing backend: packet or obvhs.
+    #[arg(long, default_value = "packet")]
+    pub backend: String,
+    /// ISA of the packet backend: avx512, avx2 or portable (default: best available, or
+    /// the DIBENCH_ISA environment variable).
+    #[arg(long)]
+    pub isa: Option<String>,
 }
 
 #[derive(Args, Debug)]
@@ -112,6 +124,40 @@ fn load(scene: &str) -> Result<PreparedScene> {
     Ok(PreparedScene::new(Scene::load(&path)?))
 }
 
+/// `--isa`, else `DIBENCH_ISA`, else the best the CPU has.
+fn isa(arg: &Option<String>) -> Result<Isa> {
+    match arg {
+        Some(s) => Isa::parse(s),
+        None => Isa::detect(),
+    }
+}
+
+/// Loads a scene traced by the named backend.
+fn load_with(c: &Common) -> Result<PreparedScene> {
+    let path = Scene::resolve(&c.scene)?;
+    let scene = Scene::load(&path)?;
+    match c.backend.as_str() {
+        "obvhs" => Ok(PreparedScene::new(scene)),
+        "packet" => {
+            let isa = isa(&c.isa)?;
+            let mut err = None;
+            let prepared =
+                PreparedScene::with_tracer(scene, |g| match PacketTracer::build(g.clone(), isa) {
+                    Ok(t) => Box::new(t),
+                    Err(e) => {
+                        err = Some(e);
+                        Box::new(ObvhsTracer::build(g))
+                    }
+                });
+            match err {
+                Some(e) => Err(e),
+                None => Ok(prepared),
+            }
+        }
+        other => Err(rays::unknown_backend(other)),
+    }
+}
+
 fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
     let n = threads.unwrap_or_else(|| {
         std::thread::available_parallelism()
@@ -132,6 +178,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Compare(a) => run_compare(a),
         Command::Reference(a) => run_reference(a),
+        Command::Rays(a) => run_rays(a),
         Command::Strategies { scene } => run_strategies(scene),
         Command::Warp(a) => run_warp(a),
     }
@@ -139,7 +186,7 @@ pub fn run(cli: Cli) -> Result<()> {
 
 fn run_reference(a: ReferenceArgs) -> Result<()> {
     let (pool, threads) = pool(a.common.threads)?;
-    let scene = load(&a.common.scene)?;
+    let scene = load_with(&a.common)?;
     for integrand in strategy::integrands(&scene) {
         let (image, meta) =
             pool.install(|| reference::render(&scene, integrand, a.spp, a.common.seed, threads))?;
@@ -166,7 +213,7 @@ fn run_compare(a: CompareArgs) -> Result<()> {
     if a.reference_spp == 0 {
         return Err(Error::Usage("--reference-spp must be at least 1".into()));
     }
-    let scene = load(&a.common.scene)?;
+    let scene = load_with(&a.common)?;
     let (mut run, mut skipped) = strategy::applicable(&scene);
     if let Some(wanted) = &a.strategies {
         for w in wanted {
@@ -351,5 +398,83 @@ fn run_warp(a: WarpArgs) -> Result<()> {
         )));
     }
     println!("{}: passed at alpha = {}", r.label, a.alpha);
+    Ok(())
+}
+
+#[derive(Args, Debug)]
+pub struct RaysArgs {
+    /// Scene file, or the name of a scene in scenes/.
+    #[arg(default_value = "bunny")]
+    pub scene: String,
+    /// Output root; the table goes to <out>/<scene>/rays.csv.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Comma-separated backends (obvhs, packet); packet runs at every available ISA.
+    #[arg(long, value_delimiter = ',', default_value = "obvhs,packet")]
+    pub backend: Vec<String>,
+    /// Only this ISA for the packet backend (default: every ISA the CPU has).
+    #[arg(long)]
+    pub isa: Option<String>,
+    /// Tracing threads (default 1: single-thread throughput).
+    #[arg(long, default_value_t = 1)]
+    pub threads: usize,
+    /// Image side of the ray sets, in pixels.
+    #[arg(long, default_value_t = 512)]
+    pub size: u32,
+    /// Timing rounds (best round is reported; order alternates between rounds).
+    #[arg(long, default_value_t = 5)]
+    pub rounds: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+fn run_rays(a: RaysArgs) -> Result<()> {
+    for b in &a.backend {
+        if !rays::BACKENDS.contains(&b.as_str()) {
+            return Err(rays::unknown_backend(b));
+        }
+    }
+    if a.size == 0 || a.rounds == 0 {
+        return Err(Error::Usage(
+            "--size and --rounds must be at least 1".into(),
+        ));
+    }
+    let isas = match (&a.isa, std::env::var("DIBENCH_ISA")) {
+        (Some(s), _) => vec![Isa::parse(s)?],
+        (None, Ok(s)) if !s.is_empty() => vec![Isa::detect()?],
+        _ => Isa::available(),
+    };
+    let (pool, threads) = pool(Some(a.threads))?;
+    let scene = load(&a.scene)?;
+    let name = scene.scene.name.clone();
+    let sets = rays::generate(&scene, a.size, a.seed);
+    let subjects = rays::subjects(&scene, &a.backend, &isas)?;
+    let rows = pool.install(|| rays::measure(&name, &sets, &subjects, a.rounds, threads));
+    let path = a.out.join(&name).join("rays.csv");
+    crate::output::write_csv(&path, &rows)?;
+    println!(
+        "scene {name} · {} threads · {}x{} rays per class · best of {} rounds",
+        threads, a.size, a.size, a.rounds
+    );
+    println!(
+        "{:<8} {:<9} {:<15} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}",
+        "backend", "isa", "ray_class", "rays", "Mrays/s", "x obvhs", "lanes", "nodes/r", "tests/r"
+    );
+    let opt = |x: Option<f64>, p: usize| x.map_or("-".to_string(), |v| format!("{v:.p$}"));
+    for r in &rows {
+        println!(
+            "{:<8} {:<9} {:<15} {:>8} {:>9.2} {:>10} {:>8} {:>8} {:>8}",
+            r.backend,
+            r.isa,
+            r.ray_class,
+            r.rays,
+            r.mrays_per_s,
+            opt(r.ratio_to_obvhs, 2),
+            opt(r.active_lane_fraction, 2),
+            opt(r.nodes_per_ray, 1),
+            opt(r.tests_per_ray, 1)
+        );
+    }
+    println!("results: {}", path.display());
     Ok(())
 }

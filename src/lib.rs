@@ -20,6 +20,7 @@ pub mod prepare;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod simd;
 pub mod stats;
 pub mod strategy;
 pub mod tracer;

@@ -50,6 +50,16 @@ impl WatertightRay {
             sz: 1.0 / d[kz],
         }
     }
+
+    /// The axis permutation (kx, ky, kz), for SIMD kernels that replicate this test.
+    pub fn axes(&self) -> [usize; 3] {
+        [self.kx, self.ky, self.kz]
+    }
+
+    /// The shear constants (sx, sy, sz).
+    pub fn shear(&self) -> [f32; 3] {
+        [self.sx, self.sy, self.sz]
+    }
 }
 
 /// Hit distance and barycentrics (b1, b2) of the hit point p = (1-b1-b2) v0 + b1 v1 + b2 v2.

@@ -1,6 +1,7 @@
 //! The benchmark commands: high-sample references and equal-time comparisons.
 
 pub mod compare;
+pub mod rays;
 pub mod reference;
 
 use crate::film::{Film, Image};

@@ -16,15 +16,15 @@ pub fn probe_radiance(
     probes: &Probes,
 ) -> Vec3 {
     let mut l = Vec3::ZERO;
-    if let Some(s) = probes.shadow {
-        if !scene.tracer.occluded(&s.ray) {
-            l += s.value;
-        }
+    if let Some(s) = probes.shadow
+        && !scene.tracer.occluded(&s.ray)
+    {
+        l += s.value;
     }
-    if let Some(e) = probes.emission {
-        if let Some(hit) = scene.tracer.intersect(&e.ray) {
-            l += emission_contribution(scene, strategy, sp, &e, &hit);
-        }
+    if let Some(e) = probes.emission
+        && let Some(hit) = scene.tracer.intersect(&e.ray)
+    {
+        l += emission_contribution(scene, strategy, sp, &e, &hit);
     }
     l
 }

@@ -3,6 +3,7 @@
 //! trait, so the SIMD packet core and Embree drop in behind it.
 
 pub mod bvh;
+pub mod packet;
 
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;

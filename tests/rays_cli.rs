@@ -1,0 +1,71 @@
+//! `dibench rays` and `--backend`/`--isa` reject bad names with a clear error, no panic.
+
+use std::process::Command;
+
+fn run(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_dibench"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn unknown_backend_lists_known_ones() {
+    for args in [
+        &["rays", "cornell", "--backend", "obvhs,embreex"][..],
+        &["reference", "cornell", "--backend", "embreex", "--spp", "1"][..],
+    ] {
+        let (ok, err) = run(args);
+        assert!(!ok);
+        assert!(err.contains("unknown backend `embreex`"), "{err}");
+        assert!(err.contains("obvhs, packet"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn bad_isa_is_a_clear_error() {
+    let (ok, err) = run(&["rays", "cornell", "--isa", "sse9"]);
+    assert!(!ok && err.contains("unknown ISA `sse9`"), "{err}");
+    // An ISA this CPU lacks (if any) names the available ones.
+    if let Some(missing) = ["avx512", "avx2"]
+        .into_iter()
+        .find(|i| dibench::simd::Isa::parse(i).is_err())
+    {
+        let (ok, err) = run(&["rays", "cornell", "--isa", missing]);
+        assert!(!ok && err.contains("not supported by this CPU"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+}
+
+#[test]
+fn rays_writes_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let (ok, err) = run(&[
+        "rays", "cornell", "--out", out, "--size", "16", "--rounds", "1",
+    ]);
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(dir.path().join("cornell/rays.csv")).unwrap();
+    let header = csv.lines().next().unwrap();
+    for col in [
+        "backend",
+        "isa",
+        "ray_class",
+        "rays",
+        "seconds",
+        "mrays_per_s",
+        "active_lane_fraction",
+        "nodes_per_ray",
+    ] {
+        assert!(header.split(',').any(|c| c == col), "{header}");
+    }
+    for class in ["primary", "shadow_area", "shadow_distant", "incoherent"] {
+        assert!(csv.contains(&format!("obvhs,scalar,{class}")), "{csv}");
+        assert!(csv.contains(&format!("packet,portable,{class}")), "{csv}");
+    }
+}
