@@ -1,10 +1,11 @@
 //! The `dibench` command line.
 
 use crate::error::{Error, Result};
-use crate::harness::{compare, reference};
+use crate::harness::{compare, crosscheck, reference};
 use crate::prepare::PreparedScene;
 use crate::scene::Scene;
 use crate::strategy;
+use crate::tracer::backends;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -30,6 +31,44 @@ pub enum Command {
         /// Scene file or name under scenes/.
         scene: Option<String>,
     },
+    /// Trace fixed ray sets through every compiled-in backend and compare each with obvhs.
+    #[command(after_help = CROSSCHECK_HELP)]
+    Crosscheck(CrosscheckArgs),
+}
+
+const CROSSCHECK_HELP: &str = "\
+Ray sets: primary (camera rays in 4x4 tiles), shadow_area (surface points to light samples,
+finite tmax), incoherent (uniform hemisphere directions from surface points); each traced for
+closest hit and occlusion, single rays and 16-packets. Fails (non-zero exit) when, against
+obvhs, per set: hit/miss mismatches > 1e-4 of the rays, primitive mismatches > 1e-4 (ties,
+where our exact tests hit both primitives at the same t within 1e-4, are excepted), occlusion
+mismatches > 1e-4, max relative t difference > 1e-3, or the image relative RMSE after 4 passes
+of the same strategy and seed > 1e-2. Timing (seconds, mrays_per_s) is single-threaded, best of
+5 interleaved rounds. Without --features embree only obvhs is compiled in and it trivially
+agrees with itself.";
+
+/// Which tracer backend renders: `obvhs` (default), or `embree` with --features embree.
+#[derive(Args, Debug)]
+pub struct BackendArg {
+    /// Tracer backend (obvhs; embree when built with --features embree).
+    #[arg(long, default_value = backends::DEFAULT)]
+    pub backend: String,
+}
+
+#[derive(Args, Debug)]
+pub struct CrosscheckArgs {
+    /// Scene file, or the name of a scene in scenes/ (e.g. cornell).
+    #[arg(default_value = "cornell")]
+    pub scene: String,
+    /// Output root; the table goes to <out>/<scene>/crosscheck.csv.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Seed of the ray sets and of the renders.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads for the renders (ray tracing and timing are single-threaded).
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 #[derive(Args, Debug)]
@@ -52,6 +91,8 @@ pub struct Common {
 pub struct CompareArgs {
     #[command(flatten)]
     pub common: Common,
+    #[command(flatten)]
+    pub backend: BackendArg,
     /// Wall-clock budget per strategy, in seconds.
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub time: f64,
@@ -67,14 +108,34 @@ pub struct CompareArgs {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub common: Common,
+    #[command(flatten)]
+    pub backend: BackendArg,
     /// Samples per pixel.
     #[arg(long, default_value_t = 8192)]
     pub spp: u64,
 }
 
 fn load(scene: &str) -> Result<PreparedScene> {
+    load_with(scene, backends::DEFAULT)
+}
+
+fn load_with(scene: &str, backend: &str) -> Result<PreparedScene> {
+    backends::check(backend)?;
     let path = Scene::resolve(scene)?;
-    Ok(PreparedScene::new(Scene::load(&path)?))
+    let scene = Scene::load(&path)?;
+    let mut err = None;
+    let prepared =
+        PreparedScene::with_tracer(scene, |g| match backends::build(backend, g.clone()) {
+            Ok(t) => t,
+            Err(e) => {
+                err = Some(e);
+                backends::build(backends::DEFAULT, g).expect("the default backend always builds")
+            }
+        });
+    match err {
+        Some(e) => Err(e),
+        None => Ok(prepared),
+    }
 }
 
 fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
@@ -98,12 +159,13 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Compare(a) => run_compare(a),
         Command::Reference(a) => run_reference(a),
         Command::Strategies { scene } => run_strategies(scene),
+        Command::Crosscheck(a) => run_crosscheck(a),
     }
 }
 
 fn run_reference(a: ReferenceArgs) -> Result<()> {
     let (pool, threads) = pool(a.common.threads)?;
-    let scene = load(&a.common.scene)?;
+    let scene = load_with(&a.common.scene, &a.backend.backend)?;
     let (image, meta) =
         pool.install(|| reference::render(&scene, a.spp, a.common.seed, threads))?;
     let path = reference::save(&a.common.out, &image, &meta)?;
@@ -128,7 +190,7 @@ fn run_compare(a: CompareArgs) -> Result<()> {
     if a.reference_spp == 0 {
         return Err(Error::Usage("--reference-spp must be at least 1".into()));
     }
-    let scene = load(&a.common.scene)?;
+    let scene = load_with(&a.common.scene, &a.backend.backend)?;
     let (mut run, mut skipped) = strategy::applicable(&scene);
     if let Some(wanted) = &a.strategies {
         for w in wanted {
@@ -228,4 +290,58 @@ fn run_strategies(scene: Option<String>) -> Result<()> {
         println!("{:<12} {}{status}", s.name(), s.describe());
     }
     Ok(())
+}
+
+fn run_crosscheck(a: CrosscheckArgs) -> Result<()> {
+    let (pool, _) = pool(a.threads)?;
+    let mut scene = load(&a.scene)?;
+    if backends::AVAILABLE.len() < 2 {
+        eprintln!(
+            "crosscheck: only `obvhs` is compiled in (build with --features embree for a second backend)"
+        );
+    }
+    let report = pool.install(|| crosscheck::run(&mut scene, &a.out, a.seed))?;
+    println!(
+        "{:<12} {:<8} {:<9} {:>7} {:>6} {:>6} {:>5} {:>9} {:>6} {:>9} {:>8}",
+        "set",
+        "backend",
+        "mode",
+        "rays",
+        "hitMM",
+        "primMM",
+        "ties",
+        "t_rel",
+        "occMM",
+        "seconds",
+        "Mrays/s"
+    );
+    for r in &report.rows {
+        if let Some(d) = r.image_rel_rmse {
+            println!(
+                "{:<12} {:<8} {:<9} image relative RMSE vs obvhs {d:.3e} {}",
+                r.set,
+                r.backend,
+                r.mode,
+                if r.pass { "ok" } else { "FAIL" }
+            );
+            continue;
+        }
+        println!(
+            "{:<12} {:<8} {:<9} {:>7} {:>6} {:>6} {:>5} {:>9.2e} {:>6} {:>9.4} {:>8.2}{}",
+            r.set,
+            r.backend,
+            r.mode,
+            r.rays,
+            r.hit_mismatch,
+            r.prim_mismatch,
+            r.ties,
+            r.t_rel_max,
+            r.occlusion_mismatch,
+            r.seconds,
+            r.mrays_per_s,
+            if r.pass { "" } else { "  FAIL" }
+        );
+    }
+    println!("results: {}", report.csv.display());
+    crosscheck::into_result(&report)
 }

@@ -1,6 +1,8 @@
 //! The benchmark commands: high-sample references and equal-time comparisons.
 
 pub mod compare;
+pub mod crosscheck;
+pub mod raysets;
 pub mod reference;
 
 use crate::film::{Film, Image};
