@@ -42,7 +42,7 @@ finite tmax), incoherent (uniform hemisphere directions from surface points); ea
 closest hit and occlusion, single rays and 16-packets. Fails (non-zero exit) when, against
 obvhs, per set: hit/miss mismatches > 1e-4 of the rays, primitive mismatches > 1e-4 (ties,
 where our exact tests hit both primitives at the same t within 1e-4, are excepted), occlusion
-mismatches > 1e-4, max relative t difference > 1e-3, or the image relative RMSE after 4 passes
+mismatches > 1e-4, max t difference > 1e-3 relative to max(t, largest |origin coordinate|), or the image relative RMSE after 4 passes
 of the same strategy and seed > 1e-2. Timing (seconds, mrays_per_s) is single-threaded, best of
 5 interleaved rounds. Without --features embree only obvhs is compiled in and it trivially
 agrees with itself.";

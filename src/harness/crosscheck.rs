@@ -136,6 +136,17 @@ pub fn exact_t(scene: &PreparedScene, ray: &Ray, prim: u32) -> Option<f32> {
     }
 }
 
+/// |t_a - t_b| relative to max(t_a, largest |origin coordinate|): f32 resolves a hit point only
+/// to the precision of the coordinates involved, so for a ray starting a hair above a surface far
+/// from the world origin, t itself is the wrong scale.
+pub fn t_rel_diff(ray: &Ray, ta: f32, tb: f32) -> f64 {
+    let scale = ta
+        .abs()
+        .max(ray.origin.abs().max_element())
+        .max(f32::MIN_POSITIVE);
+    ((ta - tb).abs() / scale) as f64
+}
+
 /// Counts of disagreement between a reference and a candidate.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Agreement {
@@ -184,7 +195,7 @@ pub fn agreement(
             (None, None) => {}
             (Some(_), None) | (None, Some(_)) => a.hit_mismatch += 1,
             (Some(r), Some(o)) => {
-                let rel = ((o.t - r.t).abs() / r.t.abs().max(f32::MIN_POSITIVE)) as f64;
+                let rel = t_rel_diff(ray, r.t, o.t);
                 if r.prim == o.prim {
                     a.t_rel_max = a.t_rel_max.max(rel);
                 } else {
