@@ -162,7 +162,7 @@ fn crosscheck_passes_on_every_scene() {
         .flatten()
         .filter_map(|e| {
             let p = e.path();
-            (p.extension()? == "toml").then(|| p)
+            (p.extension()? == "toml").then_some(p)
         })
         .collect();
     names.sort();
