@@ -18,4 +18,28 @@ fn main() {
     );
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/index");
+    if std::env::var_os("CARGO_FEATURE_EMBREE").is_some() {
+        link_embree();
+    }
+}
+
+/// Links the Embree 4.4 libraries that scripts/setup-embree.sh unpacks, with an rpath so
+/// binaries, tests and benches run without LD_LIBRARY_PATH (libembree4 finds its tbb through
+/// its own $ORIGIN rpath).
+fn link_embree() {
+    let dir = std::path::PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap())
+        .join("third_party/embree/lib");
+    println!("cargo:rerun-if-changed={}", dir.display());
+    if !dir.join("libembree4.so").exists() {
+        eprintln!(
+            "error: the `embree` feature needs Embree 4.4 in {}; run scripts/setup-embree.sh first",
+            dir.display()
+        );
+        panic!(
+            "Embree libraries missing in {}: run scripts/setup-embree.sh",
+            dir.display()
+        );
+    }
+    println!("cargo:rustc-link-search=native={}", dir.display());
+    println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
 }

@@ -1,13 +1,12 @@
 //! The `dibench` command line.
 
 use crate::error::{Error, Result};
-use crate::harness::{compare, rays, reference};
+use crate::harness::{compare, crosscheck, rays, reference};
 use crate::prepare::PreparedScene;
 use crate::scene::Scene;
 use crate::simd::Isa;
 use crate::strategy;
-use crate::tracer::bvh::ObvhsTracer;
-use crate::tracer::packet::PacketTracer;
+use crate::tracer::backends;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
@@ -37,6 +36,35 @@ pub enum Command {
         /// Scene file or name under scenes/.
         scene: Option<String>,
     },
+    /// Trace fixed ray sets through every compiled-in backend and compare each with obvhs.
+    #[command(after_help = CROSSCHECK_HELP)]
+    Crosscheck(CrosscheckArgs),
+}
+
+const CROSSCHECK_HELP: &str = "\
+Ray sets: primary (camera rays in 4x4 tiles), shadow_area (surface points to light samples,
+finite tmax), incoherent (uniform hemisphere directions from surface points); each traced for
+closest hit and occlusion, single rays and 16-packets. Fails (non-zero exit) when, against
+obvhs, per set: hit/miss mismatches > 1e-4 of the rays, primitive mismatches > 1e-4 (ties,
+where our exact tests hit both primitives at the same t within 1e-4, are excepted), occlusion
+mismatches > 1e-4, max t difference > 1e-3 relative to max(t, largest |origin coordinate|), or the image relative RMSE after 4 passes
+of the same strategy and seed > 1e-2. Timing (seconds, mrays_per_s) is single-threaded, best of
+5 interleaved rounds. Without --features embree the packet backend is checked against obvhs.";
+
+#[derive(Args, Debug)]
+pub struct CrosscheckArgs {
+    /// Scene file, or the name of a scene in scenes/ (e.g. cornell).
+    #[arg(default_value = "cornell")]
+    pub scene: String,
+    /// Output root; the table goes to <out>/<scene>/crosscheck.csv.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Seed of the ray sets and of the renders.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Worker threads for the renders (ray tracing and timing are single-threaded).
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 #[derive(Args, Debug)]
@@ -53,8 +81,8 @@ pub struct Common {
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Tracing backend: packet or obvhs.
-    #[arg(long, default_value = "packet")]
+    /// Tracer backend: packet (default), obvhs, or embree when built with --features embree.
+    #[arg(long, default_value = backends::DEFAULT)]
     pub backend: String,
     /// ISA of the packet backend: avx512, avx2 or portable (default: best available, or
     /// the DIBENCH_ISA environment variable).
@@ -132,29 +160,28 @@ fn isa(arg: &Option<String>) -> Result<Isa> {
     }
 }
 
-/// Loads a scene traced by the named backend.
+/// Loads a scene traced by the backend (and ISA) `c` names.
 fn load_with(c: &Common) -> Result<PreparedScene> {
-    let path = Scene::resolve(&c.scene)?;
-    let scene = Scene::load(&path)?;
-    match c.backend.as_str() {
-        "obvhs" => Ok(PreparedScene::new(scene)),
-        "packet" => {
-            let isa = isa(&c.isa)?;
-            let mut err = None;
-            let prepared =
-                PreparedScene::with_tracer(scene, |g| match PacketTracer::build(g.clone(), isa) {
-                    Ok(t) => Box::new(t),
-                    Err(e) => {
-                        err = Some(e);
-                        Box::new(ObvhsTracer::build(g))
-                    }
-                });
-            match err {
-                Some(e) => Err(e),
-                None => Ok(prepared),
+    backends::check(&c.backend)?;
+    let isa = if c.backend == "packet" {
+        Some(isa(&c.isa)?)
+    } else {
+        None
+    };
+    let scene = Scene::load(&Scene::resolve(&c.scene)?)?;
+    let mut err = None;
+    let prepared = PreparedScene::with_tracer(scene, |g| {
+        match backends::build_isa(&c.backend, g.clone(), isa) {
+            Ok(t) => t,
+            Err(e) => {
+                err = Some(e);
+                backends::build("obvhs", g).expect("the obvhs backend always builds")
             }
         }
-        other => Err(rays::unknown_backend(other)),
+    });
+    match err {
+        Some(e) => Err(e),
+        None => Ok(prepared),
     }
 }
 
@@ -181,6 +208,7 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Rays(a) => run_rays(a),
         Command::Strategies { scene } => run_strategies(scene),
         Command::Warp(a) => run_warp(a),
+        Command::Crosscheck(a) => run_crosscheck(a),
     }
 }
 
@@ -477,4 +505,56 @@ fn run_rays(a: RaysArgs) -> Result<()> {
     }
     println!("results: {}", path.display());
     Ok(())
+}
+
+fn run_crosscheck(a: CrosscheckArgs) -> Result<()> {
+    let (pool, _) = pool(a.threads)?;
+    let mut scene = load(&a.scene)?;
+    if backends::AVAILABLE.len() < 2 {
+        eprintln!("crosscheck: only one backend is compiled in");
+    }
+    let report = pool.install(|| crosscheck::run(&mut scene, &a.out, a.seed))?;
+    println!(
+        "{:<12} {:<8} {:<9} {:>7} {:>6} {:>6} {:>5} {:>9} {:>6} {:>9} {:>8}",
+        "set",
+        "backend",
+        "mode",
+        "rays",
+        "hitMM",
+        "primMM",
+        "ties",
+        "t_rel",
+        "occMM",
+        "seconds",
+        "Mrays/s"
+    );
+    for r in &report.rows {
+        if let Some(d) = r.image_rel_rmse {
+            println!(
+                "{:<12} {:<8} {:<9} image relative RMSE vs obvhs {d:.3e} {}",
+                r.set,
+                r.backend,
+                r.mode,
+                if r.pass { "ok" } else { "FAIL" }
+            );
+            continue;
+        }
+        println!(
+            "{:<12} {:<8} {:<9} {:>7} {:>6} {:>6} {:>5} {:>9.2e} {:>6} {:>9.4} {:>8.2}{}",
+            r.set,
+            r.backend,
+            r.mode,
+            r.rays,
+            r.hit_mismatch,
+            r.prim_mismatch,
+            r.ties,
+            r.t_rel_max,
+            r.occlusion_mismatch,
+            r.seconds,
+            r.mrays_per_s,
+            if r.pass { "" } else { "  FAIL" }
+        );
+    }
+    println!("results: {}", report.csv.display());
+    crosscheck::into_result(&report)
 }

@@ -66,7 +66,9 @@ impl<'a> Renderer<'a> {
             }
         }
         let mut hits = HitPacket::default();
-        scene.tracer.intersect_packet(&cam, active, &mut hits);
+        scene
+            .tracer
+            .intersect_packet_coherent(&cam, active, &mut hits);
 
         let mut shadow = RayPacket::default();
         let mut shadow_value = [Vec3::ZERO; LANES];

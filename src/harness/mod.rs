@@ -1,7 +1,9 @@
 //! The benchmark commands: high-sample references and equal-time comparisons.
 
 pub mod compare;
+pub mod crosscheck;
 pub mod rays;
+pub mod raysets;
 pub mod reference;
 
 use crate::film::{Film, Image};

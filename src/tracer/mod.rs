@@ -2,7 +2,10 @@
 //! 16-ray SoA packets with an active-lane mask. Strategies and the renderer see only this
 //! trait, so the SIMD packet core and Embree drop in behind it.
 
+pub mod backends;
 pub mod bvh;
+#[cfg(feature = "embree")]
+pub mod embree;
 pub mod packet;
 
 use crate::geometry::sphere::Sphere;
@@ -163,5 +166,11 @@ pub trait Tracer: Send + Sync {
             }
         }
         out
+    }
+
+    /// Closest hits of a packet the caller knows is coherent (a camera tile), so a backend
+    /// can pick a coherent kernel; the same results as [`Tracer::intersect_packet`].
+    fn intersect_packet_coherent(&self, rays: &RayPacket, active: LaneMask, hits: &mut HitPacket) {
+        self.intersect_packet(rays, active, hits)
     }
 }
