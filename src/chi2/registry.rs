@@ -427,10 +427,10 @@ fn first_hit(tris: &[Triangle], w: Vec3) -> Option<(Vec3, u32)> {
     let wr = WatertightRay::new(w);
     let mut best: Option<(f32, Vec3, u32)> = None;
     for (i, t) in tris.iter().enumerate() {
-        if let Some(h) = t.intersect(&ray, &wr) {
-            if best.is_none_or(|b| h.t < b.0) {
-                best = Some((h.t, t.point(h.b1, h.b2), i as u32));
-            }
+        if let Some(h) = t.intersect(&ray, &wr)
+            && best.is_none_or(|b| h.t < b.0)
+        {
+            best = Some((h.t, t.point(h.b1, h.b2), i as u32));
         }
     }
     best.map(|(_, q, i)| (q, i))
