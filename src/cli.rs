@@ -503,6 +503,22 @@ fn run_rays(a: RaysArgs) -> Result<()> {
             opt(r.tests_per_ray, 1)
         );
     }
+    // Our best packet path against Embree's best kernel, per class (the bar to steer by).
+    for class in rows
+        .iter()
+        .map(|r| r.ray_class.clone())
+        .collect::<std::collections::BTreeSet<_>>()
+    {
+        let best = |b: &str| {
+            rows.iter()
+                .filter(|r| r.ray_class == class && r.backend == b)
+                .map(|r| r.mrays_per_s)
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
+        };
+        if let (Some(ours), Some(embree)) = (best("packet"), best("embree")) {
+            println!("packet/embree {class:<15} {:.2}", ours / embree);
+        }
+    }
     println!("results: {}", path.display());
     Ok(())
 }

@@ -19,7 +19,12 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// Backends the `rays`, `compare` and `reference` commands know.
-pub const BACKENDS: [&str; 2] = ["obvhs", "packet"];
+pub const BACKENDS: &[&str] = &[
+    "obvhs",
+    "packet",
+    #[cfg(feature = "embree")]
+    "embree",
+];
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Query {
@@ -124,6 +129,13 @@ pub fn generate(scene: &PreparedScene, size: u32, seed: u64) -> Vec<RaySet> {
 pub enum Subject {
     Obvhs(ObvhsTracer),
     Packet(PacketTracer),
+    /// Embree with `rtcIntersect1/rtcOccluded1` per ray (`packet: false`) or its 16-wide
+    /// kernels (`packet: true`), for the side-by-side with our packet core.
+    #[cfg(feature = "embree")]
+    Embree {
+        tracer: crate::tracer::embree::EmbreeTracer,
+        packet: bool,
+    },
 }
 
 impl Subject {
@@ -131,6 +143,8 @@ impl Subject {
         match self {
             Subject::Obvhs(_) => ("obvhs", "scalar"),
             Subject::Packet(p) => ("packet", p.isa().name()),
+            #[cfg(feature = "embree")]
+            Subject::Embree { packet, .. } => ("embree", if *packet { "16-wide" } else { "1-ray" }),
         }
     }
 
@@ -138,6 +152,8 @@ impl Subject {
         match self {
             Subject::Obvhs(t) => t,
             Subject::Packet(t) => t,
+            #[cfg(feature = "embree")]
+            Subject::Embree { tracer, .. } => tracer,
         }
     }
 
@@ -145,6 +161,10 @@ impl Subject {
     /// Returns a checksum so the work cannot be optimised away.
     pub fn trace(&self, set: &RaySet, threads: usize) -> u64 {
         let one = |(p, &m): (&RayPacket, &LaneMask)| -> u64 {
+            #[cfg(feature = "embree")]
+            if let Subject::Embree { tracer, packet } = self {
+                return trace_embree(tracer, *packet, set, p, m);
+            }
             match set.query {
                 Query::Closest => {
                     let mut h = HitPacket::default();
@@ -191,10 +211,48 @@ pub fn subjects(scene: &PreparedScene, backends: &[String], isas: &[Isa]) -> Res
                     out.push(Subject::Packet(PacketTracer::build(geometry.clone(), isa)?));
                 }
             }
+            #[cfg(feature = "embree")]
+            "embree" => {
+                for packet in [false, true] {
+                    out.push(Subject::Embree {
+                        tracer: crate::tracer::embree::EmbreeTracer::build(geometry.clone())?,
+                        packet,
+                    });
+                }
+            }
             other => return Err(unknown_backend(other)),
         }
     }
     Ok(out)
+}
+
+/// One packet through Embree: per-ray calls, or the 16-wide kernels with the coherent hint
+/// for camera tiles.
+#[cfg(feature = "embree")]
+fn trace_embree(
+    t: &crate::tracer::embree::EmbreeTracer,
+    packet: bool,
+    set: &RaySet,
+    p: &RayPacket,
+    m: LaneMask,
+) -> u64 {
+    let lanes = (0..crate::tracer::LANES).filter(|l| m & (1 << l) != 0);
+    match (set.query, packet) {
+        (Query::Closest, false) => lanes
+            .map(|l| t.intersect(&p.get(l)).map_or(0, |h| h.prim as u64))
+            .sum(),
+        (Query::Occluded, false) => lanes.filter(|&l| t.occluded(&p.get(l))).count() as u64,
+        (Query::Closest, true) => {
+            let mut h = HitPacket::default();
+            if set.class == "primary" {
+                t.intersect_packet_coherent(p, m, &mut h);
+            } else {
+                t.intersect_packet(p, m, &mut h);
+            }
+            h.prim.iter().map(|&x| x as u64).sum()
+        }
+        (Query::Occluded, true) => t.occluded_packet(p, m) as u64,
+    }
 }
 
 pub fn unknown_backend(name: &str) -> Error {
