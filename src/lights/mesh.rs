@@ -2,7 +2,7 @@
 //! Area sampling: a triangle chosen with probability A_i/A, then a uniform point on it, so the
 //! area pdf is 1/A over the whole mesh; converted to solid angle by d²/|cos θ_l|.
 
-use super::LightSample;
+use super::{LightSample, direction_to};
 use crate::geometry::triangle::Triangle;
 use crate::math::luminance;
 use crate::sampling::discrete::DiscreteDistribution;
@@ -48,9 +48,7 @@ impl MeshLight {
         let i = self.by_area.sample(u[2]);
         let q = self.triangles[i].point_uniform([u[0], u[1]]);
         let n = self.normals[i];
-        let d = q - p;
-        let d2 = d.length_squared();
-        let wi = d / d2.sqrt();
+        let (wi, d2) = direction_to(p, q)?;
         let cos_l = -n.dot(wi);
         if cos_l <= 0.0 {
             return None;

@@ -30,6 +30,15 @@ pub struct LightSample {
     pub distant: bool,
 }
 
+/// Unit direction and squared distance from p to a sampled light point q; None when q is p
+/// itself (a shading point on the light's own surface can draw its own position: a
+/// measure-zero event that carries no light, and would otherwise divide zero by zero).
+pub fn direction_to(p: Vec3, q: Vec3) -> Option<(Vec3, f32)> {
+    let d = q - p;
+    let d2 = d.length_squared();
+    (d2 > 0.0).then(|| (d / d2.sqrt(), d2))
+}
+
 /// How quads are sampled.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum QuadMethod {

@@ -2,7 +2,7 @@
 //! Area sampling: a uniform point q, pdf_A = 1/A, converted to solid angle at p by
 //! pdf_ω = pdf_A · d² / |cos θ_l| (Veach 1997, eq. 8.10).
 
-use super::LightSample;
+use super::{LightSample, direction_to};
 use crate::math::luminance;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
 use glam::Vec3;
@@ -40,9 +40,7 @@ impl QuadLight {
     /// light's plane: those directions carry no radiance, so no sample is the unbiased answer.
     pub fn sample_area(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
         let q = self.corner + self.edge_u * u[0] + self.edge_v * u[1];
-        let d = q - p;
-        let d2 = d.length_squared();
-        let wi = d / d2.sqrt();
+        let (wi, d2) = direction_to(p, q)?;
         let cos_l = -self.normal.dot(wi);
         if cos_l <= 0.0 {
             return None;

@@ -4,7 +4,7 @@
 //! 1 - cos θmax computed stably. From inside the sphere the cone is undefined and the
 //! sampler switches to uniform area sampling over the whole sphere, converted to solid angle.
 
-use super::LightSample;
+use super::{LightSample, direction_to};
 use crate::math::{Frame, luminance};
 use crate::sampling::warp::{
     UNIFORM_SPHERE_PDF, one_minus_cos_from_sin2, sample_uniform_cone, sample_uniform_sphere,
@@ -54,7 +54,7 @@ impl SphereLight {
         };
         let normal = frame.to_world(Vec3::new(sin_a * cos_phi, sin_a * sin_phi, -cos_a));
         let point = self.center + normal * self.radius;
-        let wi = (point - p).normalize();
+        let (wi, _) = direction_to(p, point)?;
         Some(LightSample {
             wi,
             point,
@@ -140,9 +140,7 @@ impl SphereLight {
         }
         let n = sample_uniform_sphere(u);
         let point = self.center + n * self.radius;
-        let d = point - p;
-        let dist2 = d.length_squared();
-        let wi = d / dist2.sqrt();
+        let (wi, dist2) = direction_to(p, point)?;
         let cos_l = -n.dot(wi);
         if cos_l <= 0.0 {
             return None;
@@ -185,9 +183,7 @@ impl SphereLight {
         let cap = 1.0 - self.radius / dc; // 1 - cos α_max
         let n = Frame::from_normal(to_p / dc).to_world(sample_uniform_cone(u, cap));
         let point = self.center + n * self.radius;
-        let d = point - p;
-        let dist2 = d.length_squared();
-        let wi = d / dist2.sqrt();
+        let (wi, dist2) = direction_to(p, point)?;
         let cos_l = -n.dot(wi);
         if cos_l <= 0.0 {
             return None; // the cap's rim, tangent to the line of sight (measure zero)
