@@ -11,7 +11,12 @@ use std::time::Duration;
 fn rays(c: &mut Criterion) {
     let scene = PreparedScene::new(Scene::load(&Scene::resolve("bunny").unwrap()).unwrap());
     let sets = generate(&scene, 128, 1);
-    let backends = ["obvhs".to_string(), "packet".to_string()];
+    // Every compiled-in backend: `cargo bench --features embree` puts Embree (1-ray and 16-wide)
+    // beside the packet core.
+    let backends: Vec<String> = dibench::harness::rays::BACKENDS
+        .iter()
+        .map(|b| b.to_string())
+        .collect();
     let subjects = subjects(&scene, &backends, &Isa::available()).unwrap();
     for set in &sets {
         let mut group = c.benchmark_group(format!("rays/bunny/{}", set.class));

@@ -1,6 +1,6 @@
 //! Isotropic point light: intensity I = Φ/(4π); irradiance I·cosθ/d² (inverse-square law).
 
-use super::LightSample;
+use super::{LightSample, direction_to};
 use crate::math::luminance;
 use glam::Vec3;
 
@@ -18,12 +18,7 @@ impl PointLight {
     /// The only direction there is. None at the light's own position, where I/d² is undefined
     /// (a measure-zero set of shading points).
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
-        let d = self.position - p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = d / d2.sqrt();
+        let (wi, d2) = direction_to(p, self.position)?;
         Some(LightSample {
             wi,
             point: self.position,

@@ -3,7 +3,7 @@
 //! outside the cone θe, Hermite smoothstep in cos θ between (pbrt-v4 `SpotLight::I`). With
 //! θs = θe the edge is hard.
 
-use super::LightSample;
+use super::{LightSample, direction_to};
 use crate::math::luminance;
 use glam::Vec3;
 
@@ -37,12 +37,7 @@ impl SpotLight {
     }
 
     pub fn sample(&self, p: Vec3) -> Option<LightSample> {
-        let d = self.position - p;
-        let d2 = d.length_squared();
-        if d2 == 0.0 {
-            return None;
-        }
-        let wi = d / d2.sqrt();
+        let (wi, d2) = direction_to(p, self.position)?;
         let falloff = self.falloff(-wi.dot(self.axis));
         if falloff == 0.0 {
             return None;
