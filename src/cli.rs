@@ -39,6 +39,33 @@ pub enum Command {
     /// Trace fixed ray sets through every compiled-in backend and compare each with obvhs.
     #[command(after_help = CROSSCHECK_HELP)]
     Crosscheck(CrosscheckArgs),
+    /// Every applicable strategy on every stiff case: non-finite or negative samples and
+    /// closed-form mismatches fail (non-zero exit); writes <out>/stress/stress.csv.
+    Stress(StressArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct StressArgs {
+    /// Samples per (case, strategy).
+    #[arg(long, default_value_t = 200_000)]
+    pub samples: u64,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Only these cases (comma-separated; see --list).
+    #[arg(long, value_delimiter = ',')]
+    pub cases: Option<Vec<String>>,
+    /// List the cases and exit.
+    #[arg(long)]
+    pub list: bool,
+    /// Also write each case as a scene (<dir>/<case>/scene.toml) to render with `compare`.
+    #[arg(long)]
+    pub export: Option<PathBuf>,
+    /// Output root; the table goes to <out>/stress/stress.csv.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Worker threads (default: all cores); the result does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
 }
 
 const CROSSCHECK_HELP: &str = "\
@@ -209,7 +236,83 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Strategies { scene } => run_strategies(scene),
         Command::Warp(a) => run_warp(a),
         Command::Crosscheck(a) => run_crosscheck(a),
+        Command::Stress(a) => run_stress(a),
     }
+}
+
+fn run_stress(a: StressArgs) -> Result<()> {
+    use crate::stress::{self, Status};
+    let mut cases = stress::cases::all();
+    if a.list {
+        for c in &cases {
+            println!("{:<26} {}", c.name, c.about);
+        }
+        return Ok(());
+    }
+    if let Some(names) = &a.cases {
+        for n in names {
+            if !cases.iter().any(|c| &c.name == n) {
+                return Err(Error::Usage(format!(
+                    "unknown stress case `{n}` (see `dibench stress --list`)"
+                )));
+            }
+        }
+        cases.retain(|c| names.contains(&c.name));
+    }
+    if let Some(dir) = &a.export {
+        for c in &cases {
+            c.write_to(dir)?;
+        }
+        println!("scenes: {}/<case>/scene.toml", dir.display());
+    }
+    let (pool, threads) = pool(a.threads)?;
+    let rows = pool.install(|| stress::run(&cases, a.samples, a.seed))?;
+    let path = a.out.join("stress").join("stress.csv");
+    crate::output::write_csv(&path, &rows)?;
+    println!(
+        "{} cases · {} samples per strategy · seed {} · {threads} threads",
+        cases.len(),
+        a.samples,
+        a.seed
+    );
+    println!(
+        "{:<24} {:<17} {:>5} {:>9} {:>12} {:>12} {:>7} {:>10}  status",
+        "case", "strategy", "bad", "ess", "mean", "expected", "z", "rel.var"
+    );
+    let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("-".to_string(), f);
+    for r in &rows {
+        println!(
+            "{:<24} {:<17} {:>5} {:>9.0} {:>12.5e} {:>12} {:>7} {:>10}  {:?}{}{}",
+            r.case,
+            r.strategy,
+            r.nan + r.inf + r.negative,
+            r.effective_samples,
+            r.mean,
+            opt(r.expected, &|v| format!("{v:.5e}")),
+            opt(r.z, &|v| format!("{v:.2}")),
+            opt(r.rel_variance, &|v| format!("{v:.3e}")),
+            r.status,
+            if r.detail.is_empty() { "" } else { ": " },
+            r.detail
+        );
+    }
+    let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
+    let bad: u64 = rows.iter().map(|r| r.nan + r.inf + r.negative).sum();
+    println!(
+        "{} checks: {} pass, {} unresolved, {} fail; {bad} non-finite or negative samples",
+        rows.len(),
+        count(Status::Pass),
+        count(Status::Unresolved),
+        count(Status::Fail)
+    );
+    println!("results: {}", path.display());
+    if count(Status::Fail) > 0 {
+        return Err(Error::Usage(format!(
+            "stress: {} checks failed (see above)",
+            count(Status::Fail)
+        )));
+    }
+    Ok(())
 }
 
 fn run_reference(a: ReferenceArgs) -> Result<()> {

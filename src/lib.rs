@@ -23,4 +23,5 @@ pub mod scene;
 pub mod simd;
 pub mod stats;
 pub mod strategy;
+pub mod stress;
 pub mod tracer;

@@ -30,32 +30,33 @@ impl Frame {
     }
 }
 
-/// Offsets a surface point along its geometric normal so that a ray leaving it on the side of
-/// `n` cannot re-hit the surface it starts on. Integer-ULP offset far from the origin, a tiny
-/// absolute offset near it (Wächter & Binder, "A Fast and Robust Method for Avoiding
-/// Self-Intersection", Ray Tracing Gems, ch. 6). Scale-invariant, so no scene-size epsilon.
-pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
-    const ORIGIN: f32 = 1.0 / 32.0;
-    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-    const INT_SCALE: f32 = 256.0;
-    let of_i = (n * INT_SCALE).to_array().map(|c| c as i32);
-    let pa = p.to_array();
-    let mut out = [0.0f32; 3];
+/// γₙ = nε/(1 − nε) with ε = 2⁻²⁴: a bound on the relative error of n chained f32 operations
+/// (Higham, "Accuracy and Stability of Numerical Algorithms", §3.1; pbrt-v4 §6.8.1).
+pub fn gamma(n: u32) -> f32 {
+    let e = n as f32 * (0.5 * f32::EPSILON);
+    e / (1.0 - e)
+}
+
+/// The origin of a ray leaving a computed surface point `p` towards the side of unit normal
+/// `n`: `p` is pushed along `n` just past its own error box `p_error` (absolute, per axis), then
+/// rounded away from the surface, so the true surface lies behind the origin and the ray
+/// cannot re-hit it (pbrt-v4 `OffsetRayOrigin`, §6.8.6). The offset scales with the point's
+/// actual error, not with a scene epsilon or a fixed count of ulps: a point 1e5 from the
+/// origin moves by its few-ulp error (~0.05), not by the ~2 units that a 256-ulp offset would,
+/// and a receiver 1e-6 below a light stays below it. A point with no error is not moved.
+pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3) -> Vec3 {
+    let d = n.abs().dot(p_error);
+    let offset = n * d;
+    let mut po = (p + offset).to_array();
+    let off = offset.to_array();
     for k in 0..3 {
-        let bits = pa[k].to_bits() as i32;
-        let moved = if pa[k] < 0.0 {
-            bits - of_i[k]
-        } else {
-            bits + of_i[k]
-        };
-        let p_i = f32::from_bits(moved as u32);
-        out[k] = if pa[k].abs() < ORIGIN {
-            pa[k] + FLOAT_SCALE * n.to_array()[k]
-        } else {
-            p_i
-        };
+        if off[k] > 0.0 {
+            po[k] = po[k].next_up();
+        } else if off[k] < 0.0 {
+            po[k] = po[k].next_down();
+        }
     }
-    Vec3::from_array(out)
+    Vec3::from_array(po)
 }
 
 /// Luminance with Rec. 709 weights: the scalar that light selection and relMSE use.
@@ -94,16 +95,41 @@ mod tests {
         }
     }
 
+    /// The offset origin lies strictly in front of the plane (normal n) through every corner of
+    /// the error box, and moves no further than the box's projection plus rounding.
     #[test]
-    fn offset_moves_to_the_normal_side_at_every_scale() {
-        for scale in [0.0f32, 1e-3, 1.0, 1e3, 1e5] {
-            let p = Vec3::new(scale, -scale, 0.5 * scale);
-            let n = Vec3::new(0.3, -0.2, 0.9).normalize();
-            let q = offset_ray_origin(p, n);
-            assert!(
-                (q - p).dot(n) > 0.0,
-                "scale {scale}: offset not on the normal side"
-            );
+    fn offset_clears_the_error_box_at_every_scale() {
+        for scale in [1e-3f32, 1.0, 1e3, 1e5] {
+            for n in [
+                Vec3::new(0.3, -0.2, 0.9).normalize(),
+                Vec3::new(-1.0, 0.0, 0.0),
+                Vec3::new(0.0, 1.0, 1e-4).normalize(),
+            ] {
+                let p = Vec3::new(scale, -scale, 0.5 * scale);
+                let err = gamma(7) * p.abs();
+                let q = offset_ray_origin(p, err, n);
+                for corner in 0..8 {
+                    let s = Vec3::new(
+                        if corner & 1 == 0 { -1.0 } else { 1.0 },
+                        if corner & 2 == 0 { -1.0 } else { 1.0 },
+                        if corner & 4 == 0 { -1.0 } else { 1.0 },
+                    );
+                    let c = (p.as_dvec3() + (s * err).as_dvec3()).as_vec3().as_dvec3();
+                    assert!(
+                        (q.as_dvec3() - c).dot(n.as_dvec3()) > 0.0,
+                        "scale {scale}, n {n}: origin not in front of corner {corner}"
+                    );
+                }
+                let moved = (q - p).length();
+                let bound = n.abs().dot(err) + 4.0 * f32::EPSILON * p.abs().max_element();
+                assert!(moved <= bound, "scale {scale}: moved {moved} > {bound}");
+            }
         }
+    }
+
+    #[test]
+    fn a_point_without_error_is_not_moved() {
+        let p = Vec3::new(0.25, 1.0, -3.0);
+        assert_eq!(offset_ray_origin(p, Vec3::ZERO, Vec3::Y), p);
     }
 }

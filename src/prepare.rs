@@ -42,6 +42,8 @@ pub struct PreparedScene {
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceHit {
     pub p: Vec3,
+    /// Absolute per-axis error bound of `p`, for offsetting rays that leave it.
+    pub p_error: Vec3,
     /// Unit geometric normal: the winding's side for triangles, outward for spheres.
     pub ng: Vec3,
     pub material: u32,
@@ -174,20 +176,22 @@ impl PreparedScene {
     }
 
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
-        let (p, ng) = match self.geometry.sphere_index(hit.prim) {
+        let (p, p_error, ng) = match self.geometry.sphere_index(hit.prim) {
             None => {
                 let t = &self.geometry.triangles[hit.prim as usize];
                 // Barycentric position: more accurate than o + t·d, which matters for offsets.
-                (t.point(hit.u, hit.v), t.cross().normalize())
+                let (u, v) = (hit.u, hit.v);
+                (t.point(u, v), t.point_error(u, v), t.cross().normalize())
             }
             Some(s) => {
                 let s = &self.geometry.spheres[s];
                 let p = s.project(ray.at(hit.t));
-                (p, s.normal_at(p))
+                (p, s.point_error(p), s.normal_at(p))
             }
         };
         SurfaceHit {
             p,
+            p_error,
             ng,
             material: self.prim_material[hit.prim as usize],
             emitter: self.prim_emitter[hit.prim as usize],

@@ -87,8 +87,9 @@ impl<'a> Renderer<'a> {
             if direct {
                 radiance[lane] += scene.emitted(&surf, ray.dir);
             }
-            let sp = ShadingPoint::new(
+            let sp = ShadingPoint::with_error(
                 surf.p,
+                surf.p_error,
                 surf.ng,
                 ray.dir,
                 scene.bsdfs[surf.material as usize],

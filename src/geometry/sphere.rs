@@ -13,13 +13,17 @@ pub struct Sphere {
 impl Sphere {
     /// Nearest t in (0, ray.tmax) of a unit-direction ray. The discriminant is computed as
     /// r² - |f - (f·d)d|² and the roots as q/a, c/q (Haines et al., "Precision Improvements for
-    /// Ray/Sphere Intersection", Ray Tracing Gems, ch. 7), which stays accurate for small
-    /// spheres far from the ray origin, where the textbook b² - 4ac cancels.
+    /// Ray/Sphere Intersection", Ray Tracing Gems, ch. 7), in f64: for a near-tangent chord,
+    /// such as a shadow ray from a point 1e-6 above a unit sphere to a sampled point 1e-3 away,
+    /// the discriminant is ~1e-7 and f32 would bury it under the rounding of |perp|² (≈ 1.2e-7),
+    /// reporting the light's own surface as an occluder. The inputs are f32, exact in f64.
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
-        let f = ray.origin - self.center;
-        let b = -f.dot(ray.dir);
-        let perp = f + ray.dir * b;
-        let r2 = self.radius * self.radius;
+        let f = ray.origin.as_dvec3() - self.center.as_dvec3();
+        let dir = ray.dir.as_dvec3();
+        let b = -f.dot(dir);
+        let perp = f + dir * b;
+        let r = self.radius as f64;
+        let r2 = r * r;
         let disc = r2 - perp.length_squared();
         if disc < 0.0 {
             return None;
@@ -33,13 +37,17 @@ impl Sphere {
             let x = c / q;
             if x < q { (x, q) } else { (q, x) }
         };
-        if t0 > 0.0 && t0 < ray.tmax {
-            Some(t0)
-        } else if t1 > 0.0 && t1 < ray.tmax {
-            Some(t1)
+        let tmax = ray.tmax as f64;
+        let t = if t0 > 0.0 && t0 < tmax {
+            t0
+        } else if t1 > 0.0 && t1 < tmax {
+            t1
         } else {
-            None
-        }
+            return None;
+        };
+        // Rounding to f32 must not carry a hit past tmax or down to 0.
+        let t32 = t as f32;
+        (t32 > 0.0 && t32 < ray.tmax).then_some(t32)
     }
 
     /// Outward unit normal at a point on (or near) the surface.
@@ -50,6 +58,15 @@ impl Sphere {
     /// Projects a point computed from a ray back onto the surface, removing the error in t.
     pub fn project(&self, p: Vec3) -> Vec3 {
         self.center + (p - self.center).normalize() * self.radius
+    }
+
+    /// Absolute error bound of a point on the surface computed as centre + r·n̂ (by
+    /// [`Self::project`] or a sampler): γ₅ on the reprojected offset (pbrt-v4 §6.8.5), one more
+    /// rounding for adding the centre.
+    pub fn point_error(&self, p: Vec3) -> Vec3 {
+        use crate::math::gamma;
+        let local = (p - self.center).abs();
+        gamma(6) * local + gamma(1) * self.center.abs()
     }
 }
 

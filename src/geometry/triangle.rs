@@ -88,6 +88,13 @@ impl Triangle {
         self.v0 * (1.0 - b1 - b2) + self.v1 * b1 + self.v2 * b2
     }
 
+    /// Absolute error bound of [`Self::point`]: γ₇ Σ|bᵢ vᵢ| (pbrt-v4 §6.8.5, barycentric
+    /// reconstruction; b₀ = 1 − b₁ − b₂ adds two roundings of its own).
+    pub fn point_error(&self, b1: f32, b2: f32) -> Vec3 {
+        let b0 = 1.0 - b1 - b2;
+        crate::math::gamma(7) * ((self.v0 * b0).abs() + (self.v1 * b1).abs() + (self.v2 * b2).abs())
+    }
+
     /// Two-sided intersection in (0, ray.tmax).
     pub fn intersect(&self, ray: &Ray, wr: &WatertightRay) -> Option<TriangleHit> {
         let o = ray.origin;

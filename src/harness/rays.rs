@@ -94,7 +94,7 @@ pub fn generate(scene: &PreparedScene, size: u32, seed: u64) -> Vec<RaySet> {
                 } else {
                     -surf.ng
                 };
-                let o = offset_ray_origin(surf.p, n);
+                let o = offset_ray_origin(surf.p, surf.p_error, n);
                 let key = seed ^ ((ty as u64 * tiles as u64 + tx as u64) << 4 | lane as u64) << 8;
                 let u = |i: u64| u01(key.wrapping_add(i));
                 if let Some((_, ls)) = scene.sample_light(

@@ -53,8 +53,9 @@ pub fn generate(scene: &PreparedScene, seed: u64) -> Vec<RaySet> {
             continue;
         };
         let surf = scene.surface(ray, &hit);
-        let sp = ShadingPoint::new(
+        let sp = ShadingPoint::with_error(
             surf.p,
+            surf.p_error,
             surf.ng,
             ray.dir,
             crate::bsdf::Bsdf::lambertian(glam::Vec3::ONE),

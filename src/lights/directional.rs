@@ -24,6 +24,7 @@ impl DirectionalLight {
             wi: self.to_light,
             point: Vec3::ZERO,
             normal: Vec3::ZERO,
+            point_error: Vec3::ZERO,
             radiance: self.irradiance,
             pdf: 1.0,
             distant: true,

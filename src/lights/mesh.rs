@@ -4,6 +4,7 @@
 
 use super::{LightSample, direction_to};
 use crate::geometry::triangle::Triangle;
+use crate::math::gamma;
 use crate::math::luminance;
 use crate::sampling::discrete::DiscreteDistribution;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalTriangle, triangle_solid_angle};
@@ -46,7 +47,7 @@ impl MeshLight {
     /// rescaled u would have no resolution left), u[0..2] the point on it.
     pub fn sample_area(&self, p: Vec3, u: [f32; 3]) -> Option<LightSample> {
         let i = self.by_area.sample(u[2]);
-        let q = self.triangles[i].point_uniform([u[0], u[1]]);
+        let (q, q_error) = self.triangles[i].point_uniform([u[0], u[1]]);
         let n = self.normals[i];
         let (wi, d2) = direction_to(p, q)?;
         let cos_l = -n.dot(wi);
@@ -57,6 +58,7 @@ impl MeshLight {
             wi,
             point: q,
             normal: n,
+            point_error: q_error,
             radiance: self.radiance,
             pdf: d2 / (self.area * cos_l),
             distant: false,
@@ -77,9 +79,10 @@ impl MeshLight {
 }
 
 impl Triangle {
-    pub fn point_uniform(&self, u: [f32; 2]) -> Vec3 {
+    /// A uniform point and its error bound.
+    pub fn point_uniform(&self, u: [f32; 2]) -> (Vec3, Vec3) {
         let (b1, b2) = sample_uniform_triangle(u);
-        self.point(b1, b2)
+        (self.point(b1, b2), self.point_error(b1, b2))
     }
 }
 
@@ -129,6 +132,7 @@ impl MeshLight {
             wi: w.as_vec3(),
             point,
             normal: self.normals[i],
+            point_error: gamma(3) * (p.abs() + (w * dist).as_vec3().abs()),
             radiance: self.radiance,
             pdf,
             distant: false,

@@ -22,6 +22,8 @@ pub struct LightSample {
     /// shading point (zero for a point light).
     pub point: Vec3,
     pub normal: Vec3,
+    /// Absolute per-axis error bound of `point`, to offset the shadow ray's far end by.
+    pub point_error: Vec3,
     /// Incident radiance along -wi; for a delta light, the irradiance at normal incidence I/d².
     pub radiance: Vec3,
     /// Solid-angle pdf; 1 for a delta light.
@@ -95,11 +97,20 @@ impl LightSample {
     /// The unoccluded-test segment from a shading point (already offset) to the sample, with the
     /// light end offset off the light's own surface so the light does not shadow itself.
     pub fn shadow_ray(&self, origin: Vec3) -> Option<Ray> {
-        let target = if self.normal == Vec3::ZERO {
-            self.point
+        if self.distant {
+            // Unbounded, along the light's direction. (Until the stress suite's exact shading
+            // points exposed it, this fell through to a segment towards `point` = the world
+            // origin: directional shadows were tested against the wrong segment.)
+            return Some(Ray::new(origin, self.wi, f32::INFINITY));
+        }
+        // The far end steps off the light's surface towards the shading point, past its own
+        // error box (pbrt-v4 `SpawnRayTo`).
+        let towards = if self.normal.dot(origin - self.point) >= 0.0 {
+            self.normal
         } else {
-            offset_ray_origin(self.point, self.normal)
+            -self.normal
         };
+        let target = offset_ray_origin(self.point, self.point_error, towards);
         let d = target - origin;
         let dist = d.length();
         if dist == 0.0 {

@@ -23,6 +23,7 @@ impl PointLight {
             wi,
             point: self.position,
             normal: Vec3::ZERO,
+            point_error: Vec3::ZERO,
             radiance: self.intensity / d2,
             pdf: 1.0,
             distant: false,

@@ -3,6 +3,7 @@
 //! pdf_ω = pdf_A · d² / |cos θ_l| (Veach 1997, eq. 8.10).
 
 use super::{LightSample, direction_to};
+use crate::math::gamma;
 use crate::math::luminance;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
 use glam::Vec3;
@@ -49,6 +50,10 @@ impl QuadLight {
             wi,
             point: q,
             normal: self.normal,
+            // Two products and two sums (Higham's γ bound), plus the slack between the exact
+            // parallelogram and the two f32 triangles it is traced as.
+            point_error: gamma(6)
+                * (self.corner.abs() + (self.edge_u * u[0]).abs() + (self.edge_v * u[1]).abs()),
             radiance: self.radiance,
             pdf: d2 / (self.area * cos_l),
             distant: false,
@@ -104,6 +109,8 @@ impl QuadLight {
             wi,
             point,
             normal: self.normal,
+            // p + d rounded to f32; the f64 direction's own error is far below that.
+            point_error: gamma(3) * (p.abs() + d.as_vec3().abs()),
             radiance: self.radiance,
             pdf: (1.0 / rect.area()) as f32,
             distant: false,

@@ -7,10 +7,9 @@
 use super::{LightSample, direction_to};
 use crate::math::{Frame, luminance};
 use crate::sampling::warp::{
-    UNIFORM_SPHERE_PDF, one_minus_cos_from_sin2, sample_uniform_cone, sample_uniform_sphere,
-    uniform_cone_pdf,
+    UNIFORM_SPHERE_PDF, sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf,
 };
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug)]
@@ -26,41 +25,58 @@ impl SphereLight {
         PI * 4.0 * PI * self.radius * self.radius * luminance(self.radiance)
     }
 
-    pub fn sample_cone(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
-        let to_c = self.center - p;
+    /// Axis (centre − p), squared distance and 1 − cos θmax of the cone the sphere subtends
+    /// from an outside point, in f64: from 1e-6 above a unit sphere, d² − r² = 2e-6 would keep
+    /// only 4 bits in f32. 1 − cos θmax = sin²θmax/(1 + cos θmax) with cos²θmax = (d² − r²)/d².
+    fn cone_extent(&self, p: Vec3) -> Option<(DVec3, f64, f64)> {
+        let to_c = self.center.as_dvec3() - p.as_dvec3();
         let d2 = to_c.length_squared();
-        let r2 = self.radius * self.radius;
+        let r = self.radius as f64;
+        let r2 = r * r;
         if d2 <= r2 {
-            return self.sample_area_inside(p, u);
+            return None;
         }
+        let omc_max = (r2 / d2) / (1.0 + ((d2 - r2) / d2).sqrt());
+        Some((to_c, d2, omc_max))
+    }
+
+    pub fn sample_cone(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        let Some((to_c, d2, omc_max)) = self.cone_extent(p) else {
+            return self.sample_directions_inside(p, u);
+        };
         let dc = d2.sqrt();
-        let sin2_max = r2 / d2;
-        let omc_max = one_minus_cos_from_sin2(sin2_max);
-        let frame = Frame::from_normal(to_c / dc);
-        let local = sample_uniform_cone(u, omc_max);
-        // The point on the sphere from the sampled cone angle θ, without a ray cast (Akalin
-        // 2015, as in pbrt-v4): α, the angle at the centre between -axis and the point, has
-        // cos α = sin²θ/sin θmax + cos θ·sqrt(1 - sin²θ/sin²θmax). A ray cast would lose tiny
-        // spheres to f32 error.
-        let (cos_t, sin2_t) = (local.z, local.x * local.x + local.y * local.y);
-        let sin_max = sin2_max.sqrt();
-        let cos_a = sin2_t / sin_max + cos_t * (1.0 - sin2_t / sin2_max).max(0.0).sqrt();
-        let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
+        let r = self.radius as f64;
+        let frame = Frame::from_normal((to_c / dc).as_vec3());
+        let local = sample_uniform_cone(u, omc_max as f32);
+        // The point where the sampled direction meets the sphere, in f64 and without
+        // cancellation. Its distance is the smaller root of the ray–sphere quadratic in the
+        // form t = (d² − r²)/(d cos θ + sqrt(r² − d² sin²θ)); the angle α at the centre between
+        // the axis towards p and the point follows from the law of sines, sin α = t sin θ / r.
+        // (Akalin's cos α = sin²θ/sin θmax + cos θ·sqrt(1 − sin²θ/sin²θmax), used by pbrt-v4,
+        // rounds cos α to 1 in f32 when p is 1e-6 from the surface: every direction with θ < 60°
+        // then lands on the foot point. A ray cast in f32 would lose tiny spheres instead.)
+        let (lx, ly, cos_t) = (local.x as f64, local.y as f64, local.z as f64);
+        let sin2_t = lx * lx + ly * ly;
+        let t = (d2 - r * r) / (dc * cos_t + (r * r - d2 * sin2_t).max(0.0).sqrt());
         let sin_t = sin2_t.sqrt();
+        let sin_a = (t * sin_t / r).min(1.0);
+        let cos_a = (1.0 - sin_a * sin_a).sqrt(); // α ≤ acos(r/d) < 90°
         let (cos_phi, sin_phi) = if sin_t > 0.0 {
-            (local.x / sin_t, local.y / sin_t)
+            (lx / sin_t, ly / sin_t)
         } else {
             (1.0, 0.0)
         };
-        let normal = frame.to_world(Vec3::new(sin_a * cos_phi, sin_a * sin_phi, -cos_a));
+        let normal = frame.to_world(DVec3::new(sin_a * cos_phi, sin_a * sin_phi, -cos_a).as_vec3());
         let point = self.center + normal * self.radius;
-        let (wi, _) = direction_to(p, point)?;
         Some(LightSample {
-            wi,
+            // The sampled direction itself, which the cone pdf describes; `point` (rounded to
+            // f32) is only where the shadow ray ends.
+            wi: frame.to_world(local),
             point,
             normal,
+            point_error: self.point_error(point),
             radiance: self.radiance,
-            pdf: uniform_cone_pdf(omc_max),
+            pdf: uniform_cone_pdf(omc_max as f32),
             distant: false,
         })
     }
@@ -71,7 +87,7 @@ impl SphereLight {
         let d2 = to_c.length_squared();
         let r2 = self.radius * self.radius;
         if d2 <= r2 {
-            return self.pdf_area_inside(p, q);
+            return UNIFORM_SPHERE_PDF; // every direction from inside meets the sphere
         }
         let sin2_max = r2 / d2;
         // Cone membership by sin² of the angle to the axis (a cross product), which keeps its
@@ -79,10 +95,9 @@ impl SphereLight {
         let wi = (q - p).normalize();
         let axis = to_c / d2.sqrt();
         let inside = wi.dot(axis) > 0.0 && wi.cross(axis).length_squared() <= sin2_max;
-        if inside {
-            uniform_cone_pdf(one_minus_cos_from_sin2(sin2_max))
-        } else {
-            0.0
+        match self.cone_extent(p) {
+            Some((_, _, omc_max)) if inside => uniform_cone_pdf(omc_max as f32),
+            _ => 0.0,
         }
     }
 
@@ -95,6 +110,36 @@ impl SphereLight {
         } else {
             0.0
         }
+    }
+
+    /// From inside, the cone the sphere subtends is the whole sphere of directions: uniform
+    /// directions (pdf 1/4π), each ending where it leaves the sphere. Unlike area sampling it
+    /// has no 1/d² weight, so a point 1e-6 inside the surface still sees the nearby light.
+    /// The exit distance is the positive root of t² + 2bt + c = 0 (b = f·w, c = |f|² − r²),
+    /// with the discriminant as r² − |f − b w|² (Haines et al. 2019) and no cancellation, in f64.
+    fn sample_directions_inside(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        let w32 = sample_uniform_sphere(u);
+        let (w, f) = (w32.as_dvec3(), p.as_dvec3() - self.center.as_dvec3());
+        let r = self.radius as f64;
+        let b = f.dot(w);
+        let c = f.length_squared() - r * r; // ≤ 0 inside
+        let disc = (r * r - (f - w * b).length_squared()).max(0.0);
+        let root = disc.sqrt();
+        let t = if b > 0.0 { -c / (b + root) } else { root - b };
+        if t <= 0.0 {
+            return None; // p on the surface, leaving outwards: measure zero
+        }
+        let n = (f + w * t).normalize(); // outward normal at the exit point
+        let point = self.center + (n * r).as_vec3();
+        Some(LightSample {
+            wi: w32,
+            point,
+            normal: -n.as_vec3(), // towards p: the inward face
+            point_error: self.point_error(point),
+            radiance: self.radiance,
+            pdf: UNIFORM_SPHERE_PDF,
+            distant: false,
+        })
     }
 
     /// Uniform over the whole sphere's area, for points inside it, where every surface point
@@ -118,6 +163,7 @@ impl SphereLight {
             wi,
             point,
             normal: -n,
+            point_error: self.point_error(point),
             radiance: self.radiance,
             pdf: area_pdf * dist2 / cos_l,
             distant: false,
@@ -126,6 +172,15 @@ impl SphereLight {
 }
 
 impl SphereLight {
+    /// Error bound of a sampled surface point centre + r·n̂ (as for traced sphere hits).
+    fn point_error(&self, point: Vec3) -> Vec3 {
+        crate::geometry::sphere::Sphere {
+            center: self.center,
+            radius: self.radius,
+        }
+        .point_error(point)
+    }
+
     fn area(&self) -> f32 {
         4.0 * PI * self.radius * self.radius
     }
@@ -149,6 +204,7 @@ impl SphereLight {
             wi,
             point,
             normal: n,
+            point_error: self.point_error(point),
             radiance: self.radiance,
             pdf: dist2 / (self.area() * cos_l),
             distant: false,
@@ -193,6 +249,7 @@ impl SphereLight {
             wi,
             point,
             normal: n,
+            point_error: self.point_error(point),
             radiance: self.radiance,
             pdf: dist2 / (cap_area * cos_l),
             distant: false,

@@ -46,6 +46,7 @@ impl SpotLight {
             wi,
             point: self.position,
             normal: Vec3::ZERO,
+            point_error: Vec3::ZERO,
             radiance: self.intensity * (falloff / d2),
             pdf: 1.0,
             distant: false,

@@ -29,12 +29,18 @@ pub struct ShadingPoint {
 }
 
 impl ShadingPoint {
-    /// A point seen along `view_dir` (unit, pointing at the surface).
+    /// An exact point (no error to step over: rays start at `p` itself) seen along
+    /// `view_dir` (unit, pointing at the surface): a point given by a test or stress case.
     pub fn new(p: Vec3, ng: Vec3, view_dir: Vec3, bsdf: Bsdf) -> Self {
+        Self::with_error(p, Vec3::ZERO, ng, view_dir, bsdf)
+    }
+
+    /// A computed surface point whose coordinates are known to within `p_error` per axis.
+    pub fn with_error(p: Vec3, p_error: Vec3, ng: Vec3, view_dir: Vec3, bsdf: Bsdf) -> Self {
         let n = if ng.dot(view_dir) < 0.0 { ng } else { -ng };
         ShadingPoint {
             p,
-            origin: offset_ray_origin(p, n),
+            origin: offset_ray_origin(p, p_error, n),
             n,
             wo: -view_dir,
             bsdf,
