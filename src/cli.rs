@@ -296,6 +296,30 @@ fn run_stress(a: StressArgs) -> Result<()> {
             r.detail
         );
     }
+    println!();
+    println!(
+        "{:<24} {:>4} {:>4} {:>10} {:>4} {:>9}  lowest relative variance",
+        "case", "runs", "pass", "unresolved", "fail", "nonfinite"
+    );
+    for c in &cases {
+        let of: Vec<_> = rows.iter().filter(|r| r.case == c.name).collect();
+        let n = |s: Status| of.iter().filter(|r| r.status == s).count();
+        let best = of
+            .iter()
+            .filter(|r| r.status == Status::Pass)
+            .filter_map(|r| r.rel_variance.map(|v| (v, &r.strategy)))
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+            .map_or("-".to_string(), |(v, s)| format!("{s} {v:.2e}"));
+        println!(
+            "{:<24} {:>4} {:>4} {:>10} {:>4} {:>9}  {best}",
+            c.name,
+            of.iter().filter(|r| r.samples > 0).count(),
+            n(Status::Pass),
+            n(Status::Unresolved),
+            n(Status::Fail),
+            of.iter().map(|r| r.nan + r.inf + r.negative).sum::<u64>(),
+        );
+    }
     let count = |s: Status| rows.iter().filter(|r| r.status == s).count();
     let bad: u64 = rows.iter().map(|r| r.nan + r.inf + r.negative).sum();
     println!(

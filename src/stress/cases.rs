@@ -446,6 +446,41 @@ fn spots(out: &mut Vec<StressCase>) {
     }
 }
 
+/// A directional light's shadow ray runs along the light's direction, unbounded: an occluder
+/// straight above p blocks it, one beside p (between p and the world origin) does not.
+fn directional(out: &mut Vec<StressCase>) {
+    let light =
+        "[[directional_light]]\ndirection = [0.0, -1.0, 0.0]\nirradiance = [2.0, 2.0, 2.0]\n";
+    let p = DVec3::new(5.0, 0.0, 5.0);
+    for (name, occluder, e) in [
+        (
+            "directional-occluded",
+            quad_body(
+                DVec3::new(4.0, 3.0, 4.0),
+                DVec3::new(2.0, 0.0, 0.0),
+                DVec3::new(0.0, 0.0, 2.0),
+                None,
+            ),
+            0.0,
+        ),
+        (
+            "directional-open",
+            "[[sphere]]\ncenter = [2.5, 0.0, 2.5]\nradius = 0.5\nmaterial = \"grey\"\n".to_string(),
+            2.0,
+        ),
+    ] {
+        out.push(lambert_case(
+            name.into(),
+            format!("directional light from straight above, {name}"),
+            format!("{light}{occluder}"),
+            p,
+            DVec3::Y,
+            LIGHT_ONLY,
+            move |_| e,
+        ));
+    }
+}
+
 /// Every stiff case, in a stable order.
 pub fn all() -> Vec<StressCase> {
     let mut out = Vec::new();
@@ -456,5 +491,6 @@ pub fn all() -> Vec<StressCase> {
     phong(&mut out);
     far_geometry(&mut out);
     spots(&mut out);
+    directional(&mut out);
     out
 }

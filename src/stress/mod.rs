@@ -293,7 +293,8 @@ fn judge(
         return row;
     }
     let z = s.z_score(expected);
-    row.z = Some(z);
+    // A deterministic estimator (a delta light) has no standard error and no z.
+    row.z = (s.std_error() > 0.0).then_some(z);
     // Plus the f32 rounding of the estimator's own arithmetic, all that is left when an
     // estimator has (next to) no variance.
     let rounding = 16.0 * f32::EPSILON as f64 * expected.abs();
