@@ -12,6 +12,7 @@ pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod harness;
+pub mod interrupt;
 pub mod lights;
 pub mod math;
 pub mod metrics;
