@@ -3,8 +3,8 @@
 //! nothing half-written. A second one exits at once (every output is written by temp file and
 //! rename, so even then no partial file is left behind).
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 static REQUESTED: AtomicBool = AtomicBool::new(false);
 static INSTALL: Once = Once::new();

@@ -226,6 +226,26 @@ fn cli_compare_writes_exrs_and_csv() {
         );
     }
     assert!(dir.path().join("out/ok/reference/direct.exr").is_file());
+
+    // A truncated stored reference is an error naming it, not a panic or a silent re-render.
+    let stored = dir.path().join("out/ok/reference/direct.exr");
+    let bytes = std::fs::read(&stored).unwrap();
+    std::fs::write(&stored, &bytes[..bytes.len() / 3]).unwrap();
+    let (code, stderr) = dibench(
+        &[
+            "compare",
+            "ok.toml",
+            "--time",
+            "0.1",
+            "--reference-spp",
+            "64",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert_ne!(code, 0, "a truncated reference was accepted");
+    assert!(stderr.contains("direct.exr"), "{stderr}");
     let leftovers: Vec<_> = walk(&dir.path().join("out"))
         .into_iter()
         .filter(|p| p.to_string_lossy().contains(".tmp-"))
