@@ -265,3 +265,100 @@ fn walk(p: &Path) -> Vec<std::path::PathBuf> {
     }
     out
 }
+
+/// Every class of bad scene input, through the command line: exit status 1, an error naming the
+/// file and the field (or line), no panic, and nothing written.
+#[test]
+fn every_bad_input_class_exits_nonzero_naming_file_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("nan.obj"),
+        "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("inf.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 inf 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("index.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+    )
+    .unwrap();
+    std::fs::create_dir(dir.path().join("folder.obj")).unwrap();
+    let mesh = |f: &str| format!("{GOOD}[[mesh]]\nfile = \"{f}\"\nmaterial = \"m\"\n");
+    let classes: Vec<(&str, String, &[&str])> = vec![
+        (
+            "malformed TOML",
+            GOOD.replace("width = 8", "width = = 8"),
+            &["line 7"],
+        ),
+        (
+            "unknown key",
+            GOOD.replace(
+                "albedo = [0.5, 0.5, 0.5]",
+                "albedo = [0.5, 0.5, 0.5]\ncolour = 1",
+            ),
+            &["colour"],
+        ),
+        (
+            "missing file",
+            mesh("gone.obj"),
+            &["mesh[0].file", "gone.obj"],
+        ),
+        ("unreadable file", mesh("folder.obj"), &["folder.obj"]),
+        (
+            "NaN vertex",
+            mesh("nan.obj"),
+            &["mesh[0].file", "nan.obj", "vertex 2"],
+        ),
+        (
+            "Inf vertex",
+            mesh("inf.obj"),
+            &["mesh[0].file", "inf.obj", "vertex 3"],
+        ),
+        (
+            "index out of range",
+            mesh("index.obj"),
+            &["mesh[0].file", "index.obj", "index"],
+        ),
+        (
+            "negative radiance",
+            GOOD.replace("emission = [1.0, 1.0, 1.0]", "emission = [1.0, -2.0, 1.0]"),
+            &["quad[0].emission"],
+        ),
+        (
+            "non-finite radiance",
+            GOOD.replace("emission = [1.0, 1.0, 1.0]", "emission = [inf, 1.0, 1.0]"),
+            &["quad[0].emission"],
+        ),
+        (
+            "zero-size image",
+            GOOD.replace("height = 8", "height = 0"),
+            &["image"],
+        ),
+        (
+            "unknown material name",
+            GOOD.replace("material = \"m\"", "material = \"chrome\""),
+            &["quad[0].material", "chrome"],
+        ),
+    ];
+    for (class, text, fields) in classes {
+        std::fs::write(dir.path().join("bad.toml"), text).unwrap();
+        let (code, stderr) = dibench(&["compare", "bad.toml", "--out", "out"], dir.path());
+        assert_eq!(code, 1, "{class}: exit status {code}, stderr {stderr}");
+        assert!(stderr.contains("bad.toml"), "{class}: {stderr}");
+        for f in fields {
+            assert!(
+                stderr.contains(f),
+                "{class}: `{stderr}` does not mention `{f}`"
+            );
+        }
+        assert!(!stderr.contains("backtrace"), "{class}: {stderr}");
+    }
+    assert!(
+        !dir.path().join("out").exists(),
+        "a rejected scene left output behind"
+    );
+}

@@ -270,7 +270,9 @@ impl Scene {
                 )
             })?;
             hasher.update(&bytes);
-            let (mut positions, triangles) = obj::load(&file)?;
+            // Name the scene's field too: the user may not know which scene line the OBJ came from.
+            let (mut positions, triangles) = obj::load(&file)
+                .map_err(|e| Error::field(path, format!("mesh[{i}].file"), e.to_string()))?;
             let t = &m.transform;
             if !(t.scale.is_finite() && t.scale > 0.0) {
                 return Err(Error::field(
