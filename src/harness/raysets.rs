@@ -28,7 +28,7 @@ impl RaySet {
 pub const SET_NAMES: [&str; 3] = ["primary", "shadow_area", "incoherent"];
 
 /// Camera rays (one per pixel, jittered, tile by tile), then from each surface the primary rays
-/// hit (found with the scene's own tracer): a shadow ray to a light sample (finite tmax) and a
+/// hit (found with the scene's own tracer): a shadow ray to a light sample in front of the surface (finite tmax) and a
 /// uniformly random direction into the hemisphere facing the camera (infinite tmax). Shadow
 /// rays need a light with positive power; the set is empty otherwise.
 pub fn generate(scene: &PreparedScene, seed: u64) -> Vec<RaySet> {
@@ -65,6 +65,9 @@ pub fn generate(scene: &PreparedScene, seed: u64) -> Vec<RaySet> {
         if let Some(r) = scene
             .sample_light(sp.p, u_select, u, &crate::lights::LightMethods::BASIC)
             .and_then(|(_, ls)| ls.shadow_ray(sp.origin))
+            // Only the rays a renderer traces: a light behind the surface is never tested
+            // (and the origin is offset to the front side only).
+            .filter(|r| r.dir.dot(sp.n) > 0.0)
         {
             shadow.push(r);
         }

@@ -415,6 +415,37 @@ fn far_geometry(out: &mut Vec<StressCase>) {
     out.push(case);
 }
 
+/// A floor in the plane y = 0, the shading point found by a traced ray: the point's error
+/// bound along the normal is exactly zero, so its rays start on the floor itself and only the
+/// intersector's own conservative t bound (pbrt-v4 §6.8.7) keeps them from re-hitting it.
+/// Without that bound every shadow ray was occluded at t ~ 1e-10 (found by the Embree
+/// cross-check on the Cornell box, whose floor, back and left walls lie in such planes).
+fn plane_through_origin(out: &mut Vec<StressCase>) {
+    let (fu, fv) = (DVec3::new(0.0, 0.0, 4.0), DVec3::new(4.0, 0.0, 0.0));
+    let floor_corner = DVec3::new(-2.0, 0.0, -2.0);
+    let (lu, lv) = (DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 1.0));
+    // Off to the side: rays towards it are x-dominant, so the watertight test's shear mixes
+    // the floor's coordinates and its t for the floor is rounding, not an exact 0.
+    let light_corner = DVec3::new(1.8, 1.0, -0.5);
+    let mut body = quad_body(floor_corner, fu, fv, None);
+    body += &quad_body(light_corner, lu, lv, Some(1.0));
+    let verts = quad_vertices(light_corner, lu, lv);
+    let p = DVec3::new(0.3, 0.0, -0.2);
+    let mut case = lambert_case(
+        "plane-through-origin".into(),
+        "point on a floor in the plane y = 0 (zero error along the normal), found by a traced ray"
+            .into(),
+        body,
+        p,
+        DVec3::Y,
+        ALL,
+        move |p| polygon_irradiance(p, DVec3::Y, &verts, 1.0),
+    );
+    // From beside the light, so the traced ray meets the floor first.
+    case.point.trace_from = Some(p + DVec3::new(-2.0, 1.5, 0.0));
+    out.push(case);
+}
+
 /// Spot lights with cones of 0° (lights only its axis: nothing reaches an off-axis point) and
 /// 180° (all directions: a point light).
 fn spots(out: &mut Vec<StressCase>) {
@@ -490,6 +521,7 @@ pub fn all() -> Vec<StressCase> {
     meshes(&mut out);
     phong(&mut out);
     far_geometry(&mut out);
+    plane_through_origin(&mut out);
     spots(&mut out);
     directional(&mut out);
     out

@@ -117,6 +117,7 @@ fn triangle<L: Lanes>(
     let neg = L::lt(u, zero) | L::lt(v, zero) | L::lt(w, zero);
     let pos = L::lt(zero, u) | L::lt(zero, v) | L::lt(zero, w);
     let mut hit = m & !edge0 & !(neg & pos);
+    let mut unsure: Mask = 0;
     let det = L::add(L::add(u, v), w);
     hit &= !L::eq(det, zero);
     if hit != 0 {
@@ -128,6 +129,38 @@ fn triangle<L: Lanes>(
         let tss = L::select(L::lt(det, zero), L::sub(zero, ts), ts);
         let tm = L::load(tmax);
         hit &= L::lt(zero, tss) & L::lt(tss, L::mul(tm, L::abs(det)));
+        // t within the test's error bound (pbrt-v4 §6.8.7): see `conservative_t_bound`, same
+        // expression, same order as the scalar test.
+        if hit != 0 {
+            let amax = |p: L::V, q: L::V, r: L::V| L::max(L::max(L::abs(p), L::abs(q)), L::abs(r));
+            let (max_xt, max_yt) = (amax(ax, bx, cx), amax(ay, by, cy));
+            let (max_zt, max_e) = (amax(az, bz, cz), amax(u, v, w));
+            let g = |n: u32| L::splat(crate::math::gamma(n));
+            let delta_x = L::mul(g(5), L::add(max_xt, max_zt));
+            let delta_y = L::mul(g(5), L::add(max_yt, max_zt));
+            let delta_z = L::mul(g(3), max_zt);
+            let delta_e = L::mul(
+                L::splat(2.0),
+                L::add(
+                    L::add(
+                        L::mul(L::mul(g(2), max_xt), max_yt),
+                        L::mul(delta_y, max_xt),
+                    ),
+                    L::mul(delta_x, max_yt),
+                ),
+            );
+            let bound = L::mul(
+                L::splat(3.0),
+                L::add(
+                    L::add(L::mul(L::mul(g(3), max_e), max_zt), L::mul(delta_e, max_zt)),
+                    L::mul(delta_z, max_e),
+                ),
+            );
+            // Lanes inside the bound take the scalar path, which settles them in f64.
+            let ambiguous = hit & !L::lt(bound, tss);
+            hit &= !ambiguous;
+            unsure |= ambiguous;
+        }
         if hit != 0 {
             let inv = L::div(L::splat(1.0), det);
             let t = L::mul(ts, inv);
@@ -137,7 +170,7 @@ fn triangle<L: Lanes>(
             L::store(L::mul(w, inv), &mut out[2]);
         }
     }
-    let mut rest = edge0;
+    let mut rest = edge0 | unsure;
     while rest != 0 {
         let l = rest.trailing_zeros() as usize;
         rest &= rest - 1;
