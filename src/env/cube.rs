@@ -30,8 +30,10 @@ pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
     let (axis, s, t) = FACES[face];
     let m = w.dot(axis);
     let (fa, fb) = (w.dot(s) / m, w.dot(t) / m);
+    // The in-face coordinate stays below 1, or an edge point would land on the next face.
+    let x = below_one(0.5 * (fa.clamp(-1.0, 1.0) + 1.0));
     [
-        below_one((face as f32 + 0.5 * (fa.clamp(-1.0, 1.0) + 1.0)) / 6.0),
+        below_one((face as f32 + x) / 6.0),
         below_one(0.5 * (fb.clamp(-1.0, 1.0) + 1.0)),
     ]
 }

@@ -74,8 +74,9 @@ pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
             (ntt + 8, jp, jm)
         }
     };
-    let x = x.clamp(0.0, 1.0);
-    [below_one((face as f32 + x) / 12.0), below_one(y.clamp(0.0, 1.0))]
+    // The in-face coordinate stays below 1, or an edge point would land on the next face.
+    let x = below_one(x);
+    [below_one((face as f32 + x) / 12.0), below_one(y)]
 }
 
 pub fn jacobian(_uv: [f32; 2]) -> f32 {
