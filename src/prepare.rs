@@ -2,10 +2,10 @@
 //! intersects, per-primitive materials, and light structures only for the lights present.
 
 use crate::bsdf::Bsdf;
+use crate::env::{Environment, Repr};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
-use crate::env::{Environment, Repr};
 use crate::lights::directional::DirectionalLight;
 use crate::lights::environment::EnvironmentLight;
 use crate::lights::mesh::MeshLight;

@@ -650,10 +650,7 @@ fn build_env<const R: usize, const S: usize>(p: &Params) -> Result<WarpCase, Str
         sampler: EnvSampler::ALL[S],
     };
     let n = tile as usize;
-    let env = std::sync::Arc::new(Environment::build_with(
-        &synthetic_environment(sun),
-        [n; 4],
-    ));
+    let env = std::sync::Arc::new(Environment::build_with(&synthetic_environment(sun), [n; 4]));
     let env2 = env.clone();
     let name = crate::strategy::env_light_name(method);
     Ok(WarpCase {

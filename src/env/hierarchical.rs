@@ -22,7 +22,10 @@ pub struct HierarchicalWarp {
 impl HierarchicalWarp {
     /// `weights` is the atlas (tiles·n wide, n high, row-major); None when all are zero.
     pub fn new(weights: &[f64], tiles: usize, n: usize) -> Option<Self> {
-        assert!(n.is_power_of_two(), "hierarchical warping needs a power-of-two tile");
+        assert!(
+            n.is_power_of_two(),
+            "hierarchical warping needs a power-of-two tile"
+        );
         let width = tiles * n;
         let mut levels = Vec::with_capacity(tiles);
         let mut tile_cdf = vec![0.0];

@@ -208,8 +208,9 @@ mod tests {
                     let du = (r.uv_to_dir([uv[0] + h, uv[1]]) - r.uv_to_dir([uv[0] - h, uv[1]]))
                         .as_dvec3()
                         / (2.0 * h as f64);
-                    let dv = (r.uv_to_dir([uv[0], uv[1] + 1e-3]) - r.uv_to_dir([uv[0], uv[1] - 1e-3]))
-                        .as_dvec3()
+                    let dv = (r.uv_to_dir([uv[0], uv[1] + 1e-3])
+                        - r.uv_to_dir([uv[0], uv[1] - 1e-3]))
+                    .as_dvec3()
                         / 2e-3;
                     let fd = du.cross(dv).length();
                     let jac = r.jacobian(uv) as f64;

@@ -181,9 +181,7 @@ impl Light {
     /// no points (its pdf is by direction: `EnvironmentLight::pdf`).
     pub fn pdf(&self, p: Vec3, q: Vec3, local: u32, m: &LightMethods) -> f32 {
         match self {
-            Light::Point(_) | Light::Spot(_) | Light::Directional(_) | Light::Environment(_) => {
-                0.0
-            }
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_) | Light::Environment(_) => 0.0,
             Light::Quad(l) => match m.quad {
                 QuadMethod::Area => l.pdf_area(p, q),
                 QuadMethod::SolidAngle => l.pdf_solid_angle(p, q),

@@ -4,13 +4,13 @@
 pub mod file;
 mod obj;
 
+use crate::env::map::LatLongImage;
 use crate::error::{Error, Result};
 use file::SceneFile;
-use crate::env::map::LatLongImage;
 use glam::{Quat, Vec3};
-use std::sync::Arc;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct Scene {

@@ -2,8 +2,8 @@
 //! this strategy uses for its kind, and one shadow ray. Estimator f·L·cos θ / (pmf·pdf_ω).
 //! `light` uses the lecture's basic samplers; each variant swaps one kind's sampler.
 
-use super::{Probes, ShadingPoint, ShadowProbe, Strategy};
 use super::Integrand;
+use super::{Probes, ShadingPoint, ShadowProbe, Strategy};
 use crate::env::Repr;
 use crate::lights::{Light, LightMethods, LightSample};
 use crate::prepare::PreparedScene;

@@ -95,8 +95,7 @@ impl Strategy for Mis {
         }
         if !scene.scene.has_emitters() && !scene.scene.has_environment() {
             return Err(
-                "no emitting surface and no environment: MIS would reduce to light sampling"
-                    .into(),
+                "no emitting surface and no environment: MIS would reduce to light sampling".into(),
             );
         }
         if self.env_variant {

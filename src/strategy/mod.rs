@@ -137,7 +137,12 @@ pub trait Strategy: Send + Sync {
     }
 
     /// Weight of environment radiance found by an emission probe that escaped (MIS overrides).
-    fn env_weight(&self, _scene: &PreparedScene, _sp: &ShadingPoint, _probe: &EmissionProbe) -> f32 {
+    fn env_weight(
+        &self,
+        _scene: &PreparedScene,
+        _sp: &ShadingPoint,
+        _probe: &EmissionProbe,
+    ) -> f32 {
         1.0
     }
 }
@@ -272,8 +277,8 @@ pub fn integrands(scene: &PreparedScene) -> Vec<Integrand> {
         Integrand::AmbientOcclusion,
     ]
     .into_iter()
-        .filter(|&i| reference_strategy(scene, i).is_some())
-        .collect()
+    .filter(|&i| reference_strategy(scene, i).is_some())
+    .collect()
 }
 
 /// A strategy left out of a run, and why.
