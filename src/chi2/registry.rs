@@ -639,10 +639,10 @@ pub fn synthetic_environment(sun: f32) -> impl Fn(Vec3) -> Vec3 + Sync {
 fn build_env<const R: usize, const S: usize>(p: &Params) -> Result<WarpCase, String> {
     use crate::env::{EnvMethod, EnvSampler, Environment, Repr};
     let (sun, tile) = (get(p, "sun"), p["tile"]);
-    if !(sun >= 0.0) {
+    if sun.is_nan() || sun < 0.0 {
         return Err("sun must be non-negative".into());
     }
-    if !(tile >= 1.0 && tile <= 512.0 && (tile as usize).is_power_of_two()) {
+    if !((1.0..=512.0).contains(&tile) && (tile as usize).is_power_of_two()) {
         return Err("tile must be a power of two in 1..=512".into());
     }
     let method = EnvMethod {
