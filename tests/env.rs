@@ -236,3 +236,48 @@ fn environment_strategies_need_an_environment() {
         assert!(by_name(name).unwrap().applies(&scene).is_err());
     }
 }
+
+/// Bad [environment] input: errors name the file and the field, no panic.
+#[test]
+fn bad_environment_input_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    let header = "[camera]\neye = [0.0, 1.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_y_deg = 40.0\n\
+                  [image]\nwidth = 4\nheight = 4\n";
+    let mut nan = latlong_of_y(8, 4, |_, _| [1.0; 3]);
+    nan.pixels[5] = Vec3::new(1.0, f32::NAN, 0.0);
+    write_latlong(&dir.path().join("nan.exr"), &nan).unwrap();
+    for (body, field, says) in [
+        ("file = \"missing.exr\"", "environment.file", "cannot read"),
+        ("file = \"nan.exr\"", "environment.file", "not finite"),
+        (
+            "constant = [1.0, -1.0, 0.0]",
+            "environment.constant",
+            "non-negative",
+        ),
+        (
+            "constant = [1.0, 1.0, 1.0]\nfile = \"nan.exr\"",
+            "environment",
+            "exactly one",
+        ),
+        (
+            "constant = [1.0, 1.0, 1.0]\nscale = -2.0",
+            "environment.scale",
+            "non-negative",
+        ),
+        (
+            "constant = [1.0, 1.0, 1.0]\nrotate = 3.0",
+            "rotate",
+            "unknown field",
+        ),
+    ] {
+        let err = Scene::parse(&format!("{header}[environment]\n{body}\n"), &path)
+            .err()
+            .unwrap_or_else(|| panic!("accepted: {body}"))
+            .to_string();
+        assert!(
+            err.contains("bad.toml") && err.contains(field) && err.contains(says),
+            "{body}: {err}"
+        );
+    }
+}

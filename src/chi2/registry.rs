@@ -642,7 +642,8 @@ fn build_env<const R: usize, const S: usize>(p: &Params) -> Result<WarpCase, Str
     if sun.is_nan() || sun < 0.0 {
         return Err("sun must be non-negative".into());
     }
-    if !((1.0..=512.0).contains(&tile) && (tile as usize).is_power_of_two()) {
+    if !((1.0..=512.0).contains(&tile) && tile.fract() == 0.0 && (tile as usize).is_power_of_two())
+    {
         return Err("tile must be a power of two in 1..=512".into());
     }
     let method = EnvMethod {
