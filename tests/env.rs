@@ -281,3 +281,44 @@ fn bad_environment_input_is_reported() {
         );
     }
 }
+
+/// An environment mixed with a quad light, which hides the environment behind it:
+/// E = πL_env + (L_quad − L_env)·E_quad/L, with E_quad/L Lambert's polygon formula. Exercises
+/// light selection between the environment and an area light, and MIS across both.
+#[test]
+fn environment_with_a_quad_light() {
+    use dibench::closed_form::polygon_irradiance;
+    use glam::DVec3;
+    let (le, lq) = ([0.5, 0.4, 0.2], [3.0, 2.0, 1.0]);
+    let (corner, eu, ev) = (
+        DVec3::new(-0.3, 1.5, -0.2),
+        DVec3::new(0.9, 0.0, 0.2),
+        DVec3::new(0.1, 0.3, 0.7),
+    );
+    assert!(eu.cross(ev).y < 0.0, "the emitting side must face down");
+    let (scene, _dir) = prepare(
+        &format!(
+            "[environment]\nconstant = [{}, {}, {}]\n[[quad]]\ncorner = [-0.3, 1.5, -0.2]\n\
+             edge_u = [0.9, 0.0, 0.2]\nedge_v = [0.1, 0.3, 0.7]\nmaterial = \"m\"\nemission = [{}, {}, {}]\n",
+            le[0], le[1], le[2], lq[0], lq[1], lq[2]
+        ),
+        None,
+    );
+    let e_quad = polygon_irradiance(
+        DVec3::ZERO,
+        DVec3::Y,
+        &[corner, corner + eu, corner + eu + ev, corner + ev],
+        1.0,
+    );
+    let names: Vec<_> = direct_strategies(&scene).iter().map(|s| s.name()).collect();
+    assert!(
+        names.contains(&"light") && names.contains(&"mis-power"),
+        "{names:?}"
+    );
+    check_all(
+        &scene,
+        Vec3::Y,
+        std::array::from_fn(|c| PI * le[c] + (lq[c] - le[c]) * e_quad),
+        500,
+    );
+}
