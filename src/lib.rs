@@ -8,6 +8,7 @@ pub mod bsdf;
 pub mod chi2;
 pub mod cli;
 pub mod closed_form;
+pub mod env;
 pub mod error;
 pub mod film;
 pub mod geometry;

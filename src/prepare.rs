@@ -2,10 +2,12 @@
 //! intersects, per-primitive materials, and light structures only for the lights present.
 
 use crate::bsdf::Bsdf;
+use crate::env::{Environment, Repr};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
 use crate::lights::directional::DirectionalLight;
+use crate::lights::environment::EnvironmentLight;
 use crate::lights::mesh::MeshLight;
 use crate::lights::point::PointLight;
 use crate::lights::quad::QuadLight;
@@ -36,6 +38,10 @@ pub struct PreparedScene {
     pub lights: Vec<Light>,
     /// Power-proportional light selection; None when no light has positive power.
     pub light_selection: Option<DiscreteDistribution>,
+    /// The environment in every representation, built only when the scene has one.
+    pub environment: Option<Arc<Environment>>,
+    /// Index of the environment in `lights`.
+    pub env_light: Option<usize>,
 }
 
 /// A surface point hit by a ray.
@@ -140,8 +146,8 @@ impl PreparedScene {
                 cos_falloff_start: s.cos_falloff_start,
             }));
         }
+        let scene_radius = bounding_radius(&g, &scene.camera);
         if !scene.directional_lights.is_empty() {
-            let scene_radius = bounding_radius(&g, &scene.camera);
             for d in &scene.directional_lights {
                 lights.push(Light::Directional(DirectionalLight {
                     to_light: -d.direction,
@@ -150,6 +156,17 @@ impl PreparedScene {
                 }));
             }
         }
+        let environment = scene
+            .environment
+            .as_ref()
+            .map(|spec| Arc::new(Environment::build(&|w| spec.radiance(w))));
+        let env_light = environment.as_ref().map(|env| {
+            lights.push(Light::Environment(EnvironmentLight {
+                env: env.clone(),
+                scene_radius,
+            }));
+            lights.len() - 1
+        });
         let bsdfs = scene
             .materials
             .iter()
@@ -172,6 +189,25 @@ impl PreparedScene {
             bsdfs,
             lights,
             light_selection,
+            environment,
+            env_light,
+        }
+    }
+
+    /// Radiance the environment sends along -`dir` in representation `repr` (zero without one).
+    pub fn env_radiance(&self, repr: Repr, dir: Vec3) -> Vec3 {
+        match &self.environment {
+            Some(env) => env.radiance(repr, dir),
+            None => Vec3::ZERO,
+        }
+    }
+
+    /// The pdf with which [`Self::sample_light`] produces direction `wi` towards the
+    /// environment (selection probability included); 0 without one.
+    pub fn env_light_pdf(&self, wi: Vec3, methods: &LightMethods) -> f32 {
+        match (self.env_light, &self.light_selection, &self.environment) {
+            (Some(i), Some(sel), Some(env)) => sel.pmf(i) * env.pdf(methods.env, wi),
+            _ => 0.0,
         }
     }
 

@@ -6,7 +6,7 @@ use crate::geometry::Ray;
 use crate::prepare::PreparedScene;
 use crate::sampling::stream::{SampleStream, name_id};
 use crate::scene::Camera;
-use crate::strategy::{Integrand, ShadingPoint, Strategy};
+use crate::strategy::{ShadingPoint, Strategy};
 use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -77,12 +77,19 @@ impl<'a> Renderer<'a> {
         let mut emit_probe = [None; LANES];
         let mut emit_mask: LaneMask = 0;
         let mut points: [Option<ShadingPoint>; LANES] = [None; LANES];
-        let direct = self.strategy.integrand() == Integrand::Direct;
+        let direct = self.strategy.integrand().is_direct();
         for lane in 0..LANES {
-            let (Some(hit), Some(rng)) = (hits.get(lane), rngs[lane].as_mut()) else {
+            let Some(rng) = rngs[lane].as_mut() else {
                 continue;
             };
             let ray = cam.get(lane);
+            let Some(hit) = hits.get(lane) else {
+                // The camera sees the environment (zero without one).
+                if direct {
+                    radiance[lane] += scene.env_radiance(self.strategy.env_repr(), ray.dir);
+                }
+                continue;
+            };
             let surf = scene.surface(&ray, &hit);
             if direct {
                 radiance[lane] += scene.emitted(&surf, ray.dir);
@@ -119,12 +126,13 @@ impl<'a> Renderer<'a> {
             let mut ehits = HitPacket::default();
             scene.tracer.intersect_packet(&emit, emit_mask, &mut ehits);
             for lane in 0..LANES {
-                let (Some(hit), Some(probe), Some(sp)) =
-                    (ehits.get(lane), emit_probe[lane], points[lane])
-                else {
+                let (Some(probe), Some(sp)) = (emit_probe[lane], points[lane]) else {
                     continue;
                 };
-                radiance[lane] += emission_contribution(scene, self.strategy, &sp, &probe, &hit);
+                radiance[lane] += match ehits.get(lane) {
+                    Some(hit) => emission_contribution(scene, self.strategy, &sp, &probe, &hit),
+                    None => escape_contribution(scene, self.strategy, &sp, &probe),
+                };
             }
         }
         radiance
@@ -141,6 +149,24 @@ pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ra
         (c.forward + c.right * sx + c.up * sy).normalize(),
         f32::INFINITY,
     )
+}
+
+/// What an emission probe that escaped the scene adds: weight · L_env · the strategy's MIS
+/// weight, with the environment in the strategy's representation (zero without one).
+pub fn escape_contribution(
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    sp: &ShadingPoint,
+    probe: &crate::strategy::EmissionProbe,
+) -> Vec3 {
+    if scene.environment.is_none() {
+        return Vec3::ZERO;
+    }
+    let le = scene.env_radiance(strategy.env_repr(), probe.ray.dir);
+    if le == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    probe.weight * le * strategy.env_weight(scene, sp, probe)
 }
 
 /// What an emission probe that hit `hit` adds: weight · Le · the strategy's MIS weight.

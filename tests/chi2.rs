@@ -75,3 +75,42 @@ fn discrete_distribution_chi2() {
     wrong.swap(1, 4);
     assert!(run_discrete(&wrong, |u| d.sample(u), SAMPLES, 3) < 1e-6);
 }
+
+/// The environment χ² cases have teeth: a cube-map pdf that forgets the gnomonic Jacobian
+/// (texel probability spread uniformly over the face's (a, b) square, normalised over the
+/// sphere) is rejected.
+#[test]
+fn an_environment_pdf_without_its_jacobian_fails() {
+    use dibench::chi2::registry::synthetic_environment;
+    use dibench::chi2::{Chart, WarpCase};
+    use dibench::env::{EnvMethod, EnvSampler, Environment, Repr};
+    use std::sync::Arc;
+    let m = EnvMethod {
+        repr: Repr::Cube,
+        sampler: EnvSampler::Cdf,
+    };
+    let env = Arc::new(Environment::build_with(
+        &synthetic_environment(50.0),
+        [16; 4],
+    ));
+    let (e1, e2) = (env.clone(), env);
+    // Wrong: pdf × J / mean J, i.e. as if dω/(du dv) were constant (4π).
+    let wrong = move |w: glam::Vec3| {
+        let uv = Repr::Cube.dir_to_uv(w);
+        e2.pdf(m, w) as f64 * Repr::Cube.jacobian(uv) as f64 / (4.0 * std::f64::consts::PI)
+    };
+    let case = WarpCase {
+        label: "cube pdf without Jacobian".into(),
+        sample: Box::new(move |u| e1.sample(m, [u[0], u[1]]).map(|s| (s.wi, s.pdf))),
+        pdf: Box::new(wrong),
+        // The sample's own pdf is right; only the pdf() under test is wrong.
+        mismatch_slack: 1.0,
+        chart: Chart::sphere(),
+    };
+    let r = run(&case, SAMPLES, 40, 80, 11);
+    assert!(
+        r.p_value < 1e-6 || r.hard_failure.is_some(),
+        "the Jacobian-free pdf passed (p = {})",
+        r.p_value
+    );
+}

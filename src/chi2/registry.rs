@@ -94,7 +94,7 @@ fn omc_z(w: Vec3) -> f32 {
 }
 
 pub fn registry() -> Vec<WarpEntry> {
-    vec![
+    let mut v = vec![
         WarpEntry {
             name: "uniform-hemisphere",
             describe: "uniform hemisphere about +z, pdf 1/2π",
@@ -326,7 +326,9 @@ pub fn registry() -> Vec<WarpEntry> {
             "mesh light, triangle by area then spherical triangle (Arvo 1995)",
             MeshMethod::SolidAngle,
         ),
-    ]
+    ];
+    v.extend(env_entries());
+    v
 }
 
 pub fn by_name(name: &str) -> Option<WarpEntry> {
@@ -593,4 +595,70 @@ fn build_mesh(p: &Params, name: &str, method: MeshMethod) -> Result<WarpCase, St
         move |w| first_hit(&tris, w),
         chart,
     ))
+}
+
+/// One entry per (representation, sampler) of the environment light.
+fn env_entries() -> Vec<WarpEntry> {
+    vec![
+        env_entry("env-latlong-cdf", build_env::<0, 0>),
+        env_entry("env-latlong-hier", build_env::<0, 1>),
+        env_entry("env-cube-cdf", build_env::<1, 0>),
+        env_entry("env-cube-hier", build_env::<1, 1>),
+        env_entry("env-octa-cdf", build_env::<2, 0>),
+        env_entry("env-octa-hier", build_env::<2, 1>),
+        env_entry("env-healpix-cdf", build_env::<3, 0>),
+        env_entry("env-healpix-hier", build_env::<3, 1>),
+    ]
+}
+
+fn env_entry(name: &'static str, build: fn(&Params) -> Result<WarpCase, String>) -> WarpEntry {
+    WarpEntry {
+        name,
+        describe: "environment light importance sampling on a synthetic map (sun of relative strength `sun` + gradient + a black region), `tile` texels per tile side",
+        params: &[("sun", 50.0), ("tile", 16.0)],
+        suite: &[&[], &[("sun", 1e4)], &[("sun", 0.0), ("tile", 32.0)]],
+        expect_fail: false,
+        build,
+    }
+}
+
+/// A synthetic environment: a small bright sun, a sky gradient, and a black wedge (the sampler
+/// must never go there, and its pdf there must be zero).
+pub fn synthetic_environment(sun: f32) -> impl Fn(Vec3) -> Vec3 + Sync {
+    let sun_dir = Vec3::new(0.5, 0.6, -0.4).normalize();
+    move |w: Vec3| {
+        if w.x > 0.2 && w.y < 0.0 {
+            return Vec3::ZERO;
+        }
+        let sky = Vec3::new(0.3, 0.5, 1.0) * (1.2 + w.y) + Vec3::splat(0.2 * w.z.abs());
+        let s = if w.dot(sun_dir) > 0.995 { sun } else { 0.0 };
+        sky + Vec3::new(1.0, 0.9, 0.7) * s
+    }
+}
+
+fn build_env<const R: usize, const S: usize>(p: &Params) -> Result<WarpCase, String> {
+    use crate::env::{EnvMethod, EnvSampler, Environment, Repr};
+    let (sun, tile) = (get(p, "sun"), p["tile"]);
+    if sun.is_nan() || sun < 0.0 {
+        return Err("sun must be non-negative".into());
+    }
+    if !((1.0..=512.0).contains(&tile) && tile.fract() == 0.0 && (tile as usize).is_power_of_two())
+    {
+        return Err("tile must be a power of two in 1..=512".into());
+    }
+    let method = EnvMethod {
+        repr: Repr::ALL[R],
+        sampler: EnvSampler::ALL[S],
+    };
+    let n = tile as usize;
+    let env = std::sync::Arc::new(Environment::build_with(&synthetic_environment(sun), [n; 4]));
+    let env2 = env.clone();
+    let name = crate::strategy::env_light_name(method);
+    Ok(WarpCase {
+        label: label(name, p),
+        sample: Box::new(move |u| env.sample(method, [u[0], u[1]]).map(|s| (s.wi, s.pdf))),
+        pdf: Box::new(move |w| env2.pdf(method, w) as f64),
+        mismatch_slack: DEFAULT_SLACK,
+        chart: Chart::sphere(),
+    })
 }

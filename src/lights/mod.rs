@@ -3,12 +3,14 @@
 //! direct-illumination integral, or reports a delta light.
 
 pub mod directional;
+pub mod environment;
 pub mod mesh;
 pub mod point;
 pub mod quad;
 pub mod sphere;
 pub mod spot;
 
+use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
 use glam::Vec3;
@@ -76,6 +78,7 @@ pub struct LightMethods {
     pub quad: QuadMethod,
     pub sphere: SphereMethod,
     pub mesh: MeshMethod,
+    pub env: EnvMethod,
 }
 
 impl LightMethods {
@@ -84,12 +87,14 @@ impl LightMethods {
         quad: QuadMethod::Area,
         sphere: SphereMethod::Cone,
         mesh: MeshMethod::Area,
+        env: EnvMethod::LATLONG_CDF,
     };
     /// The lowest-variance sampler of each kind: solid angle everywhere.
     pub const SOLID_ANGLE: LightMethods = LightMethods {
         quad: QuadMethod::SolidAngle,
         sphere: SphereMethod::Cone,
         mesh: MeshMethod::SolidAngle,
+        env: EnvMethod::LATLONG_CDF,
     };
 }
 
@@ -129,6 +134,7 @@ pub enum Light {
     Quad(quad::QuadLight),
     Sphere(sphere::SphereLight),
     Mesh(mesh::MeshLight),
+    Environment(environment::EnvironmentLight),
 }
 
 impl Light {
@@ -141,6 +147,7 @@ impl Light {
             Light::Quad(l) => l.power(),
             Light::Sphere(l) => l.power(),
             Light::Mesh(l) => l.power(),
+            Light::Environment(l) => l.power(),
         }
     }
 
@@ -171,15 +178,17 @@ impl Light {
                 MeshMethod::Area => l.sample_area(p, u),
                 MeshMethod::SolidAngle => l.sample_solid_angle(p, u),
             },
+            Light::Environment(l) => l.sample(u2, m.env),
         }
     }
 
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction from p
     /// to the point q on this light (triangle `local` for a mesh). 0 for delta lights: no
-    /// direction found by another strategy can reach them.
+    /// direction found by another strategy can reach them; 0 for the environment, which has
+    /// no points (its pdf is by direction: `EnvironmentLight::pdf`).
     pub fn pdf(&self, p: Vec3, q: Vec3, local: u32, m: &LightMethods) -> f32 {
         match self {
-            Light::Point(_) | Light::Spot(_) | Light::Directional(_) => 0.0,
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_) | Light::Environment(_) => 0.0,
             Light::Quad(l) => match m.quad {
                 QuadMethod::Area => l.pdf_area(p, q),
                 QuadMethod::SolidAngle => l.pdf_solid_angle(p, q),
@@ -201,7 +210,9 @@ impl Light {
     /// two-sided for spheres (see docs/conventions.md).
     pub fn emitted(&self, n: Vec3, w: Vec3) -> Vec3 {
         match self {
-            Light::Point(_) | Light::Spot(_) | Light::Directional(_) => Vec3::ZERO,
+            Light::Point(_) | Light::Spot(_) | Light::Directional(_) | Light::Environment(_) => {
+                Vec3::ZERO
+            }
             Light::Quad(l) => {
                 if n.dot(w) > 0.0 {
                     l.radiance

@@ -25,6 +25,8 @@ pub struct SceneFile {
     pub directional_lights: Vec<DirectionalLightDesc>,
     /// Present: the scene also has the ambient-occlusion integrand (`ao-*` strategies).
     pub ambient_occlusion: Option<AmbientOcclusionDesc>,
+    /// Radiance arriving from infinitely far away (a lat/long EXR or a constant).
+    pub environment: Option<EnvironmentDesc>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -165,4 +167,19 @@ pub struct DirectionalLightDesc {
 pub struct AmbientOcclusionDesc {
     /// Occluders farther than this do not count.
     pub distance: f32,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    /// Lat/long RGB EXR, relative to the scene file (orientation: docs/conventions.md).
+    pub file: Option<String>,
+    /// A constant radiance [W/(m² sr)] instead of a file.
+    pub constant: Option<[f32; 3]>,
+    /// Multiplies the radiance (default 1).
+    #[serde(default = "one")]
+    pub scale: f32,
+    /// Rotation about +Y, counter-clockwise seen from +Y (as mesh transforms).
+    #[serde(default)]
+    pub rotate_y_deg: f32,
 }

@@ -4,11 +4,13 @@
 pub mod file;
 mod obj;
 
+use crate::env::map::LatLongImage;
 use crate::error::{Error, Result};
 use file::SceneFile;
 use glam::{Quat, Vec3};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -29,6 +31,34 @@ pub struct Scene {
     pub directional_lights: Vec<DirectionalLight>,
     /// Occlusion distance of the ambient-occlusion integrand, when the scene asks for it.
     pub ao_distance: Option<f32>,
+    pub environment: Option<EnvironmentSpec>,
+}
+
+/// Environment light as given: the source radiance and how it is placed.
+#[derive(Clone, Debug)]
+pub struct EnvironmentSpec {
+    pub source: EnvSource,
+    pub scale: f32,
+    /// Rotation about +Y applied to the map (counter-clockwise seen from +Y).
+    pub rotation: Quat,
+}
+
+#[derive(Clone, Debug)]
+pub enum EnvSource {
+    Image(Arc<LatLongImage>),
+    Constant(Vec3),
+}
+
+impl EnvironmentSpec {
+    /// Radiance arriving from world direction `w` (unit, pointing away from the scene), from
+    /// the source's own piecewise-constant reconstruction.
+    pub fn radiance(&self, w: Vec3) -> Vec3 {
+        let l = match &self.source {
+            EnvSource::Image(img) => img.radiance(self.rotation.inverse() * w),
+            EnvSource::Constant(c) => *c,
+        };
+        self.scale * l
+    }
 }
 
 /// Pinhole camera, right-handed: `forward` = normalize(look_at - eye), `right` = forward × up.
@@ -107,6 +137,10 @@ impl Scene {
         self.meshes.iter().any(|m| m.emission.is_some())
             || self.quads.iter().any(|q| q.emission.is_some())
             || self.spheres.iter().any(|s| s.emission.is_some())
+    }
+
+    pub fn has_environment(&self) -> bool {
+        self.environment.is_some()
     }
 
     pub fn has_delta_lights(&self) -> bool {
@@ -415,6 +449,11 @@ impl Scene {
             }
         };
 
+        let environment = match &desc.environment {
+            None => None,
+            Some(e) => Some(v.environment(e, base, &mut hasher)?),
+        };
+
         let scene = Scene {
             name: path
                 .file_stem()
@@ -433,12 +472,13 @@ impl Scene {
             spot_lights,
             directional_lights,
             ao_distance,
+            environment,
         };
-        if !scene.has_emitters() && !scene.has_delta_lights() {
+        if !scene.has_emitters() && !scene.has_delta_lights() && !scene.has_environment() {
             return Err(Error::field(
                 path,
                 "light",
-                "the scene has no light: add an `emission` to a shape or a [[point_light]]",
+                "the scene has no light: add an `emission` to a shape, a [[point_light]] or an [environment]",
             ));
         }
         Ok(scene)
@@ -485,6 +525,62 @@ impl Validator<'_> {
             ));
         }
         Ok(Some(e))
+    }
+
+    fn environment(
+        &self,
+        e: &file::EnvironmentDesc,
+        base: &Path,
+        hasher: &mut Sha256,
+    ) -> Result<EnvironmentSpec> {
+        let source = match (&e.file, e.constant) {
+            (Some(f), None) => {
+                let file = base.join(f);
+                let bytes = std::fs::read(&file).map_err(|err| {
+                    Error::field(
+                        self.path,
+                        "environment.file",
+                        format!("cannot read {}: {err}", file.display()),
+                    )
+                })?;
+                hasher.update(&bytes);
+                let img = LatLongImage::load(&file)
+                    .map_err(|m| Error::field(self.path, "environment.file", m))?;
+                EnvSource::Image(Arc::new(img))
+            }
+            (None, Some(c)) => {
+                let c = self.vec3("environment.constant", c)?;
+                if c.min_element() < 0.0 {
+                    return Err(Error::field(
+                        self.path,
+                        "environment.constant",
+                        format!("radiance must be non-negative, got {c}"),
+                    ));
+                }
+                EnvSource::Constant(c)
+            }
+            _ => {
+                return Err(Error::field(
+                    self.path,
+                    "environment",
+                    "give exactly one of `file` and `constant`",
+                ));
+            }
+        };
+        let scale = self.finite("environment.scale", e.scale)?;
+        if scale < 0.0 {
+            return Err(Error::field(
+                self.path,
+                "environment.scale",
+                "must be non-negative",
+            ));
+        }
+        let angle = self.finite("environment.rotate_y_deg", e.rotate_y_deg)?;
+        Ok(EnvironmentSpec {
+            source,
+            scale,
+            rotation: Quat::from_rotation_y(angle.to_radians()),
+        })
     }
 
     fn unit(&self, field: &str, a: [f32; 3]) -> Result<Vec3> {

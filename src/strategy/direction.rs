@@ -29,8 +29,8 @@ pub fn direction_sampling_applies(scene: &PreparedScene) -> Result<(), String> {
                 .into(),
         );
     }
-    if !scene.scene.has_emitters() {
-        return Err("the scene has no emitting surface".into());
+    if !scene.scene.has_emitters() && !scene.scene.has_environment() {
+        return Err("the scene has no emitting surface and no environment".into());
     }
     Ok(())
 }

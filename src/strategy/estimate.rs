@@ -3,7 +3,7 @@
 
 use super::{Probes, ShadingPoint, Strategy};
 use crate::prepare::PreparedScene;
-use crate::render::emission_contribution;
+use crate::render::{emission_contribution, escape_contribution};
 use crate::sampling::stream::{SampleStream, name_id};
 use crate::stats::Welford;
 use glam::Vec3;
@@ -21,10 +21,11 @@ pub fn probe_radiance(
     {
         l += s.value;
     }
-    if let Some(e) = probes.emission
-        && let Some(hit) = scene.tracer.intersect(&e.ray)
-    {
-        l += emission_contribution(scene, strategy, sp, &e, &hit);
+    if let Some(e) = probes.emission {
+        l += match scene.tracer.intersect(&e.ray) {
+            Some(hit) => emission_contribution(scene, strategy, sp, &e, &hit),
+            None => escape_contribution(scene, strategy, sp, &e),
+        };
     }
     l
 }

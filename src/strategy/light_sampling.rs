@@ -2,7 +2,9 @@
 //! this strategy uses for its kind, and one shadow ray. Estimator f·L·cos θ / (pmf·pdf_ω).
 //! `light` uses the lecture's basic samplers; each variant swaps one kind's sampler.
 
+use super::Integrand;
 use super::{Probes, ShadingPoint, ShadowProbe, Strategy};
+use crate::env::Repr;
 use crate::lights::{Light, LightMethods, LightSample};
 use crate::prepare::PreparedScene;
 use crate::sampling::stream::SampleStream;
@@ -83,7 +85,22 @@ impl Strategy for LightSampling {
         if m.mesh != b.mesh && !scene.has_light(|l| matches!(l, Light::Mesh(_))) {
             return Err("no mesh light".into());
         }
+        if m.env != b.env || self.name.starts_with("env-") {
+            if scene.environment.is_none() {
+                return Err("the scene has no environment".into());
+            }
+        } else if scene.env_light.is_some() && scene.lights.len() == 1 && m == b {
+            return Err("identical to `env-latlong-cdf`: the environment is the only light".into());
+        }
         Ok(())
+    }
+
+    fn integrand(&self) -> Integrand {
+        Integrand::direct_with(self.methods.env.repr)
+    }
+
+    fn env_repr(&self) -> Repr {
+        self.methods.env.repr
     }
 
     fn sample(&self, scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes {

@@ -9,6 +9,7 @@ pub mod light_sampling;
 pub mod mis;
 
 use crate::bsdf::Bsdf;
+use crate::env::{EnvMethod, EnvSampler, Repr};
 use crate::geometry::Ray;
 use crate::lights::{LightMethods, MeshMethod, QuadMethod, SphereMethod};
 use crate::math::offset_ray_origin;
@@ -74,8 +75,12 @@ pub struct EmissionProbe {
 /// The quantity a strategy estimates: each has its own reference image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Integrand {
-    /// Emission seen by the camera plus reflected direct illumination.
+    /// Emission seen by the camera plus reflected direct illumination (an environment, if
+    /// any, in its lat/long representation).
     Direct,
+    /// As `Direct`, with the environment resampled into another representation: a slightly
+    /// different radiance function (resampling), so it has its own reference.
+    DirectEnv(Repr),
     /// (1/π)∫ V(ω) cos θ dω with occluders within the scene's AO distance.
     AmbientOcclusion,
 }
@@ -83,9 +88,25 @@ pub enum Integrand {
 impl Integrand {
     pub fn name(&self) -> &'static str {
         match self {
-            Integrand::Direct => "direct",
+            Integrand::Direct | Integrand::DirectEnv(Repr::LatLong) => "direct",
+            Integrand::DirectEnv(Repr::Cube) => "direct-cube",
+            Integrand::DirectEnv(Repr::Octahedral) => "direct-octa",
+            Integrand::DirectEnv(Repr::Healpix) => "direct-healpix",
             Integrand::AmbientOcclusion => "ao",
         }
+    }
+
+    /// Direct illumination with the environment in representation `r`.
+    pub fn direct_with(r: Repr) -> Self {
+        match r {
+            Repr::LatLong => Integrand::Direct,
+            r => Integrand::DirectEnv(r),
+        }
+    }
+
+    /// Emission seen by the camera counts (every integrand but AO).
+    pub fn is_direct(&self) -> bool {
+        !matches!(self, Integrand::AmbientOcclusion)
     }
 }
 
@@ -114,6 +135,55 @@ pub trait Strategy: Send + Sync {
     ) -> f32 {
         1.0
     }
+
+    /// The representation this strategy looks the environment up in (escaped rays, camera
+    /// rays that miss), so that its lookups and its samplers agree.
+    fn env_repr(&self) -> Repr {
+        Repr::LatLong
+    }
+
+    /// Weight of environment radiance found by an emission probe that escaped (MIS overrides).
+    fn env_weight(
+        &self,
+        _scene: &PreparedScene,
+        _sp: &ShadingPoint,
+        _probe: &EmissionProbe,
+    ) -> f32 {
+        1.0
+    }
+}
+
+/// Names of the environment strategies per (representation, sampler), in `Repr::ALL` and
+/// `EnvSampler::ALL` order: light sampling alone, and MIS with BSDF sampling.
+const ENV_LIGHT_NAMES: [[&str; 2]; 4] = [
+    ["env-latlong-cdf", "env-latlong-hier"],
+    ["env-cube-cdf", "env-cube-hier"],
+    ["env-octa-cdf", "env-octa-hier"],
+    ["env-healpix-cdf", "env-healpix-hier"],
+];
+const ENV_MIS_NAMES: [[&str; 2]; 4] = [
+    ["mis-env-latlong-cdf", "mis-env-latlong-hier"],
+    ["mis-env-cube-cdf", "mis-env-cube-hier"],
+    ["mis-env-octa-cdf", "mis-env-octa-hier"],
+    ["mis-env-healpix-cdf", "mis-env-healpix-hier"],
+];
+
+fn env_methods() -> impl Iterator<Item = EnvMethod> {
+    Repr::ALL.into_iter().flat_map(|repr| {
+        EnvSampler::ALL
+            .into_iter()
+            .map(move |sampler| EnvMethod { repr, sampler })
+    })
+}
+
+/// Name of the environment light-sampling strategy for `m`.
+pub fn env_light_name(m: EnvMethod) -> &'static str {
+    ENV_LIGHT_NAMES[m.repr.index()][m.sampler as usize]
+}
+
+/// Name of the environment MIS strategy for `m`.
+pub fn env_mis_name(m: EnvMethod) -> &'static str {
+    ENV_MIS_NAMES[m.repr.index()][m.sampler as usize]
 }
 
 /// Every strategy dibench knows, in listing order.
@@ -121,7 +191,7 @@ pub fn registry() -> Vec<Box<dyn Strategy>> {
     use direction::{DirectionKind, DirectionSampling};
     use light_sampling::LightSampling;
     let basic = LightMethods::BASIC;
-    vec![
+    let mut v: Vec<Box<dyn Strategy>> = vec![
         Box::new(DirectionSampling(DirectionKind::UniformHemisphere)),
         Box::new(DirectionSampling(DirectionKind::CosineHemisphere)),
         Box::new(DirectionSampling(DirectionKind::Bsdf)),
@@ -158,11 +228,22 @@ pub fn registry() -> Vec<Box<dyn Strategy>> {
                 ..basic
             },
         )),
-        Box::new(mis::Mis(mis::Heuristic::Balance)),
-        Box::new(mis::Mis(mis::Heuristic::Power)),
+        Box::new(mis::Mis::new(mis::Heuristic::Balance)),
+        Box::new(mis::Mis::new(mis::Heuristic::Power)),
         Box::new(ambient_occlusion::AmbientOcclusion { cosine: false }),
         Box::new(ambient_occlusion::AmbientOcclusion { cosine: true }),
-    ]
+    ];
+    for m in env_methods() {
+        v.push(Box::new(LightSampling::variant(
+            env_light_name(m),
+            "as `light`, but the environment looked up and sampled in this representation by this sampler (cdf: marginal/conditional, hier: hierarchical warping)",
+            LightMethods { env: m, ..basic },
+        )));
+    }
+    for m in env_methods() {
+        v.push(Box::new(mis::Mis::env(env_mis_name(m), m)));
+    }
+    v
 }
 
 pub fn by_name(name: &str) -> Option<Box<dyn Strategy>> {
@@ -175,9 +256,16 @@ pub fn reference_strategy(
     scene: &PreparedScene,
     integrand: Integrand,
 ) -> Option<Box<dyn Strategy>> {
-    let order: &[&str] = match integrand {
-        Integrand::Direct => &["mis-power", "light"],
-        Integrand::AmbientOcclusion => &["ao-cosine"],
+    let env_mis = |repr| {
+        env_mis_name(EnvMethod {
+            repr,
+            sampler: EnvSampler::Cdf,
+        })
+    };
+    let order: Vec<&str> = match integrand {
+        Integrand::Direct => vec!["mis-power", env_mis(Repr::LatLong), "light"],
+        Integrand::DirectEnv(r) => vec![env_mis(r)],
+        Integrand::AmbientOcclusion => vec!["ao-cosine"],
     };
     order
         .iter()
@@ -187,10 +275,16 @@ pub fn reference_strategy(
 
 /// The integrands a scene has (the set its references are made for).
 pub fn integrands(scene: &PreparedScene) -> Vec<Integrand> {
-    [Integrand::Direct, Integrand::AmbientOcclusion]
-        .into_iter()
-        .filter(|&i| reference_strategy(scene, i).is_some())
-        .collect()
+    [
+        Integrand::Direct,
+        Integrand::DirectEnv(Repr::Cube),
+        Integrand::DirectEnv(Repr::Octahedral),
+        Integrand::DirectEnv(Repr::Healpix),
+        Integrand::AmbientOcclusion,
+    ]
+    .into_iter()
+    .filter(|&i| reference_strategy(scene, i).is_some())
+    .collect()
 }
 
 /// A strategy left out of a run, and why.
