@@ -273,6 +273,9 @@ fn run_compare(a: CompareArgs) -> Result<()> {
     if a.reference_spp == 0 {
         return Err(Error::Usage("--reference-spp must be at least 1".into()));
     }
+    if a.runs == 0 {
+        return Err(Error::Usage("--runs must be at least 1".into()));
+    }
     let scene = load_with(&a.common)?;
     let (mut run, mut skipped) = strategy::applicable(&scene);
     if let Some(wanted) = &a.strategies {
