@@ -16,6 +16,15 @@ fn main() {
         "cargo:rustc-env=DIBENCH_COMMIT={commit}{}",
         if dirty { "-dirty" } else { "" }
     );
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let rustc_version = std::process::Command::new(rustc)
+        .arg("--version")
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_else(|| "unknown".into());
+    println!("cargo:rustc-env=DIBENCH_RUSTC={rustc_version}");
     println!("cargo:rerun-if-changed=.git/HEAD");
     println!("cargo:rerun-if-changed=.git/index");
     if std::env::var_os("CARGO_FEATURE_EMBREE").is_some() {

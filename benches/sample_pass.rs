@@ -7,11 +7,16 @@ use dibench::prepare::PreparedScene;
 use dibench::render::Renderer;
 use dibench::scene::Scene;
 use dibench::strategy::applicable;
+use dibench::tracer::backends;
 use std::time::Duration;
 
 fn sample_pass(c: &mut Criterion) {
     for name in Scene::builtin_names() {
-        let scene = PreparedScene::new(Scene::load(&Scene::resolve(&name).unwrap()).unwrap());
+        // The packet backend, as `compare` uses by default, so the cost per pass matches.
+        let scene = PreparedScene::with_tracer(
+            Scene::load(&Scene::resolve(&name).unwrap()).unwrap(),
+            |g| backends::build("packet", g).expect("the packet backend always builds"),
+        );
         let (strategies, _) = applicable(&scene);
         let mut group = c.benchmark_group(format!("sample_pass/{name}"));
         group

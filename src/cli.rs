@@ -42,6 +42,12 @@ pub enum Command {
     /// Every applicable strategy on every stiff case: non-finite or negative samples and
     /// closed-form mismatches fail (non-zero exit); writes <out>/stress/stress.csv.
     Stress(StressArgs),
+    /// Figures of a compare run: RMSE against time with CI bands, variance heatmaps, image
+    /// strip; PNG (and SVG for the chart) in RUN_DIR/plots/.
+    Plot {
+        /// A run directory written by `compare` (holding results.csv).
+        run_dir: PathBuf,
+    },
 }
 
 #[derive(Args, Debug)]
@@ -130,6 +136,10 @@ pub struct CompareArgs {
     /// Comma-separated subset of strategies to run (default: every applicable one).
     #[arg(long, value_delimiter = ',')]
     pub strategies: Option<Vec<String>>,
+    /// Independent runs per strategy (seeds seed, seed+1, ...); summary.csv gives 95 %
+    /// confidence intervals over them.
+    #[arg(long, default_value_t = 1)]
+    pub runs: u32,
 }
 
 #[derive(Args, Debug)]
@@ -169,9 +179,12 @@ fn parse_param(s: &str) -> std::result::Result<(String, f64), String> {
 pub struct ReferenceArgs {
     #[command(flatten)]
     pub common: Common,
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 8192)]
-    pub spp: u64,
+    /// Samples per pixel (default 8192).
+    #[arg(long, conflicts_with = "time")]
+    pub spp: Option<u64>,
+    /// Render whole passes for this many seconds instead of a fixed spp.
+    #[arg(long, allow_negative_numbers = true)]
+    pub time: Option<f64>,
 }
 
 fn load(scene: &str) -> Result<PreparedScene> {
@@ -237,6 +250,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Warp(a) => run_warp(a),
         Command::Crosscheck(a) => run_crosscheck(a),
         Command::Stress(a) => run_stress(a),
+        Command::Plot { run_dir } => {
+            for p in crate::plot::plot_run(&run_dir)? {
+                println!("{}", p.display());
+            }
+            Ok(())
+        }
     }
 }
 
@@ -342,16 +361,29 @@ fn run_stress(a: StressArgs) -> Result<()> {
 fn run_reference(a: ReferenceArgs) -> Result<()> {
     let (pool, threads) = pool(a.common.threads)?;
     let scene = load_with(&a.common)?;
+    let budget = match (a.spp, a.time) {
+        (_, Some(t)) => reference::Budget::Time(t),
+        (n, None) => reference::Budget::Spp(n.unwrap_or(8192)),
+    };
     for integrand in strategy::integrands(&scene) {
-        let (image, meta) =
-            pool.install(|| reference::render(&scene, integrand, a.spp, a.common.seed, threads))?;
-        let path = reference::save(&a.common.out, &image, &meta)?;
+        let r = pool.install(|| {
+            reference::render_progressive(
+                &scene,
+                integrand,
+                budget,
+                a.common.seed,
+                threads,
+                Some(&a.common.out),
+            )
+        })?;
+        let path = reference::save(&a.common.out, &r.image, &r.variance, &r.meta)?;
         println!(
-            "reference: {} ({} spp, {:.1} s, strategy {})",
+            "reference: {} ({} spp, {:.1} s, strategy {}, noise floor {:.3e} RMSE)",
             path.display(),
-            meta.spp,
-            meta.wall_time_s,
-            meta.strategy
+            r.meta.spp,
+            r.meta.wall_time_s,
+            r.meta.strategy,
+            r.meta.noise_floor_rmse.unwrap_or(0.0)
         );
     }
     Ok(())
@@ -367,6 +399,9 @@ fn run_compare(a: CompareArgs) -> Result<()> {
     }
     if a.reference_spp == 0 {
         return Err(Error::Usage("--reference-spp must be at least 1".into()));
+    }
+    if a.runs == 0 {
+        return Err(Error::Usage("--runs must be at least 1".into()));
     }
     let scene = load_with(&a.common)?;
     let (mut run, mut skipped) = strategy::applicable(&scene);
@@ -420,36 +455,43 @@ fn run_compare(a: CompareArgs) -> Result<()> {
                         integrand.name(),
                         a.reference_spp
                     );
-                    let (img, meta) = reference::render(
+                    let r = reference::render(
                         &scene,
                         integrand,
                         a.reference_spp,
                         a.common.seed,
                         threads,
                     )?;
-                    reference::save(&a.common.out, &img, &meta)?;
+                    reference::save(&a.common.out, &r.image, &r.variance, &r.meta)?;
                     eprintln!(
                         "reference ({}): {:.1} s with `{}`",
                         integrand.name(),
-                        meta.wall_time_s,
-                        meta.strategy
+                        r.meta.wall_time_s,
+                        r.meta.strategy
                     );
-                    (img, meta)
+                    (r.image, r.meta)
                 }
             };
-            images.push((integrand, image, meta.spp));
+            images.push(compare::Reference {
+                integrand,
+                image,
+                spp: meta.spp,
+                noise_floor: meta.noise_floor_rmse,
+            });
         }
         let references = compare::References { images };
         let opts = compare::CompareOptions {
             time_s: a.time,
             seed: a.common.seed,
             threads,
+            runs: a.runs,
+            isa: isa_path(&a.common)?,
         };
         let report = compare::run(&scene, &run, skipped, &references, &a.common.out, &opts)?;
         let spp: Vec<String> = references
             .images
             .iter()
-            .map(|(i, _, n)| format!("{} {n} spp", i.name()))
+            .map(|r| format!("{} {} spp", r.integrand.name(), r.spp))
             .collect();
         println!(
             "scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {}",
@@ -460,20 +502,74 @@ fn run_compare(a: CompareArgs) -> Result<()> {
             a.time,
             spp.join(", ")
         );
+        let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
         println!(
-            "{:<18} {:>9} {:>8} {:>9} {:>12} {:>12}",
-            "strategy", "integrand", "spp", "time_s", "rmse", "relmse"
+            "{:<18} {:>9} {:>4} {:>8} {:>8} {:>10} {:>9} {:>10} {:>9} {:>10} {:>10} {:>6}",
+            "strategy",
+            "integrand",
+            "runs",
+            "spp",
+            "time_s",
+            "rmse",
+            "±95%",
+            "relmse",
+            "±95%",
+            "pred_rmse",
+            "efficiency",
+            "vs_best"
         );
-        for s in &run {
-            if let Some(last) = report.rows.iter().rev().find(|r| r.strategy == s.name()) {
+        for r in &report.summary {
+            println!(
+                "{:<18} {:>9} {:>4} {:>8.0} {:>8.3} {:>10.3e} {:>9} {:>10.3e} {:>9} {:>10.3e} {:>10.3e} {:>6}",
+                r.strategy,
+                r.integrand,
+                r.runs,
+                r.spp_mean,
+                r.time_s_mean,
+                r.rmse_mean,
+                ci(r.rmse_ci95),
+                r.relmse_mean,
+                ci(r.relmse_ci95),
+                r.predicted_rmse,
+                r.efficiency,
+                r.vs_best
+            );
+        }
+        let overshoot = report
+            .summary
+            .iter()
+            .map(|r| r.overshoot_max)
+            .fold(f64::NEG_INFINITY, f64::max);
+        println!(
+            "largest deviation from the budget: {:+.2} % (a run stops at the last whole pass predicted to fit)",
+            100.0 * overshoot
+        );
+        for floor in &references.images {
+            if let Some(f) = floor.noise_floor {
                 println!(
-                    "{:<18} {:>9} {:>8} {:>9.3} {:>12.5e} {:>12.5e}",
-                    last.strategy, last.integrand, last.spp, last.time_s, last.rmse, last.relmse
+                    "reference ({}) noise floor: {f:.3e} RMSE",
+                    floor.integrand.name()
                 );
             }
         }
+        for w in compare_warnings(&report.summary) {
+            eprintln!("{w}");
+        }
         println!("results: {}", report.run_dir.display());
         Ok(())
+    })
+}
+
+fn compare_warnings(rows: &[crate::harness::summary::SummaryRow]) -> Vec<String> {
+    crate::harness::summary::noise_floor_warnings(rows)
+}
+
+/// The ISA path the chosen backend runs, for run metadata.
+fn isa_path(c: &Common) -> Result<String> {
+    Ok(if c.backend == "packet" {
+        isa(&c.isa)?.name().to_string()
+    } else {
+        "scalar".to_string()
     })
 }
 

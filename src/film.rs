@@ -47,8 +47,24 @@ pub struct Film {
     pub layout: TileLayout,
     /// Sum of samples, tile-major: tile t owns `sum[16 t .. 16 t + 16]`, lane = 4·dy + dx.
     pub sum: Vec<[f64; 3]>,
+    /// Per-pixel sum of squared deviations from the running mean (Welford's M2), same order:
+    /// the per-pixel sample variance of the one-sample-per-pass estimator is m2 / (spp - 1).
+    pub m2: Vec<[f64; 3]>,
     /// Samples per pixel accumulated so far (every pixel gets one per pass).
     pub spp: u64,
+}
+
+/// Adds sample `x` as the (n+1)-th to a pixel's running sum and M2 (Welford 1962, written
+/// with the sum rather than the mean so the film's sums stay exact sums).
+#[inline]
+pub fn accumulate(sum: &mut [f64; 3], m2: &mut [f64; 3], n: u64, x: [f64; 3]) {
+    let inv_old = if n == 0 { 0.0 } else { 1.0 / n as f64 };
+    let inv_new = 1.0 / (n + 1) as f64;
+    for c in 0..3 {
+        let mean_old = sum[c] * inv_old;
+        sum[c] += x[c];
+        m2[c] += (x[c] - mean_old) * (x[c] - sum[c] * inv_new);
+    }
 }
 
 impl Film {
@@ -57,6 +73,7 @@ impl Film {
         Film {
             layout,
             sum: vec![[0.0; 3]; layout.tile_count() * 16],
+            m2: vec![[0.0; 3]; layout.tile_count() * 16],
             spp: 0,
         }
     }
@@ -68,12 +85,39 @@ impl Film {
         } else {
             1.0 / self.spp as f64
         };
+        self.scan_lines(&self.sum, inv)
+    }
+
+    /// Per-pixel variance of the mean image (sample variance / spp), in scan-line order: the
+    /// expected squared error of each pixel against the converged image. Zero below 2 spp.
+    pub fn variance_of_mean(&self) -> Image {
+        let n = self.spp as f64;
+        let scale = if self.spp < 2 {
+            0.0
+        } else {
+            1.0 / ((n - 1.0) * n)
+        };
+        self.scan_lines(&self.m2, scale)
+    }
+
+    /// Mean over pixels and channels of the per-sample variance: σ² of the 1-spp estimator,
+    /// so a render of N spp has expected MSE σ²/N against the converged image.
+    pub fn mean_sample_variance(&self) -> f64 {
+        if self.spp < 2 {
+            return 0.0;
+        }
+        let sum: f64 = self.m2.iter().map(|m| m[0] + m[1] + m[2]).sum();
+        sum / (3 * self.layout.width as usize * self.layout.height as usize) as f64
+            / (self.spp - 1) as f64
+    }
+
+    fn scan_lines(&self, data: &[[f64; 3]], scale: f64) -> Image {
         let TileLayout { width, height, .. } = self.layout;
         let mut pixels = Vec::with_capacity((width * height) as usize);
         for y in 0..height {
             for x in 0..width {
-                let s = self.sum[self.layout.index(x, y)];
-                pixels.push([s[0] * inv, s[1] * inv, s[2] * inv]);
+                let s = data[self.layout.index(x, y)];
+                pixels.push([s[0] * scale, s[1] * scale, s[2] * scale]);
             }
         }
         Image {
@@ -96,5 +140,26 @@ impl Image {
     pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
         let p = self.pixels[(y * self.width + x) as usize];
         Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stats::Welford;
+
+    #[test]
+    fn per_pixel_moments_match_welford() {
+        let xs = [0.5, 2.0, 1e3, 3.25, 0.0, 7.0];
+        let (mut sum, mut m2) = ([0.0; 3], [0.0; 3]);
+        let mut w = Welford::default();
+        for (n, &x) in xs.iter().enumerate() {
+            accumulate(&mut sum, &mut m2, n as u64, [x, 2.0 * x, 0.0]);
+            w.add(x);
+        }
+        assert!((sum[0] / xs.len() as f64 - w.mean).abs() < 1e-12);
+        assert!((m2[0] - w.m2()).abs() < 1e-9 * w.m2());
+        assert!((m2[1] - 4.0 * w.m2()).abs() < 1e-9 * w.m2());
+        assert_eq!(m2[2], 0.0);
     }
 }

@@ -18,6 +18,7 @@ pub mod lights;
 pub mod math;
 pub mod metrics;
 pub mod output;
+pub mod plot;
 pub mod prepare;
 pub mod render;
 pub mod sampling;

@@ -1,7 +1,7 @@
 //! One sample per pixel over the whole image, in 4×4 tiles: a 16-ray camera packet, then the
 //! strategy's shadow and emission probes as two more packets. Parallel over tiles with rayon.
 
-use crate::film::{Film, TileLayout};
+use crate::film::{Film, TileLayout, accumulate};
 use crate::geometry::Ray;
 use crate::prepare::PreparedScene;
 use crate::sampling::stream::{SampleStream, name_id};
@@ -35,13 +35,12 @@ impl<'a> Renderer<'a> {
         let layout = film.layout;
         film.sum
             .par_chunks_mut(16)
+            .zip(film.m2.par_chunks_mut(16))
             .enumerate()
-            .for_each(|(tile, out)| {
+            .for_each(|(tile, (sum, m2))| {
                 let radiance = self.render_tile(&layout, tile, pass);
-                for (o, l) in out.iter_mut().zip(radiance.iter()) {
-                    o[0] += l.x as f64;
-                    o[1] += l.y as f64;
-                    o[2] += l.z as f64;
+                for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
+                    accumulate(s, m, pass, [l.x as f64, l.y as f64, l.z as f64]);
                 }
             });
         film.spp += 1;

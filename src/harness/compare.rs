@@ -1,8 +1,11 @@
 //! Equal-time comparison: every applicable strategy renders for the same wall-clock budget;
 //! the error against the reference is recorded at log-spaced checkpoints, so one run gives the
-//! error-against-time curve (RMSE ∝ 1/√t for an unbiased estimator).
+//! error-against-time curve (RMSE ∝ 1/√t for an unbiased estimator). With `runs` > 1 every
+//! strategy is run that many times with independent seeds, so that the error of each is
+//! known with a confidence interval (Celarek et al. 2019); see `summary`.
 
-use super::{COMMIT, VERSION, progress_bar};
+use super::summary::{FinalRun, SummaryRow, summarize};
+use super::{COMMIT, RUSTC, VERSION, cpu_model, progress_bar};
 use crate::error::{Error, Result};
 use crate::film::{Film, Image};
 use crate::metrics::{relmse, rmse};
@@ -10,6 +13,7 @@ use crate::output::{write_csv, write_exr, write_json};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy::{Integrand, Skipped, Strategy};
+use serde::Deserialize;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -20,17 +24,23 @@ pub const CHECKPOINTS: u32 = 8;
 #[derive(Clone, Debug)]
 pub struct CompareOptions {
     pub time_s: f64,
+    /// Seed of run 0; run k uses `seed + k`.
     pub seed: u64,
     pub threads: usize,
+    /// Independent repetitions of every strategy.
+    pub runs: u32,
+    /// The ISA path the tracer runs (`avx2`, `portable`, ... or `scalar`), for the metadata.
+    pub isa: String,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ResultRow {
     pub scene: String,
     pub strategy: String,
     pub integrand: String,
     pub backend: String,
     pub threads: usize,
+    pub run: u32,
     pub seed: u64,
     pub checkpoint: u32,
     pub time_s: f64,
@@ -46,84 +56,132 @@ struct RunMeta<'a> {
     width: u32,
     height: u32,
     backend: &'a str,
+    isa: &'a str,
     threads: usize,
-    seed: u64,
+    cpu_model: String,
+    runs: u32,
+    seeds: Vec<u64>,
     budget_s: f64,
     strategies: Vec<&'a str>,
     skipped: &'a [Skipped],
     reference_spp: &'a [(String, u64)],
+    reference_noise_floor: &'a [(String, Option<f64>)],
     dibench_version: &'a str,
+    rustc: &'a str,
     commit: &'a str,
 }
 
-/// One strategy's equal-time run: passes until the budget is spent, rows at checkpoints.
-/// Time spent measuring the error is excluded from the clock.
+/// What one strategy's run leaves: the mean and variance images, the rows, and the final
+/// per-sample variance for predicting the error.
+pub struct StrategyRun {
+    pub image: Image,
+    pub variance: Image,
+    pub rows: Vec<ResultRow>,
+    pub mean_sample_variance: f64,
+}
+
+/// One strategy's equal-time run with seed `seed`: passes while the next one is predicted to
+/// end within the budget, rows at checkpoints. Time spent measuring the error is excluded
+/// from the clock.
+///
+/// Budget bound: a pass is the unit of work (a partial pass would leave some pixels with one
+/// sample fewer and bias the mean), so the loop predicts the next pass's duration as the
+/// mean pass time so far and starts it only if it is predicted to end within the budget. The
+/// final time lies within about one pass of the budget, on either side; the measured
+/// deviation is reported (`time_s` of the last row, `overshoot` in summary.csv).
 pub fn run_strategy(
     scene: &PreparedScene,
     strategy: &dyn Strategy,
     reference: &Image,
     opts: &CompareOptions,
+    run: u32,
     mut on_progress: impl FnMut(Duration),
-) -> (Image, Vec<ResultRow>) {
-    let renderer = Renderer::new(scene, strategy, opts.seed);
+) -> StrategyRun {
+    let seed = opts.seed + run as u64;
+    let renderer = Renderer::new(scene, strategy, seed);
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let budget = Duration::from_secs_f64(opts.time_s);
     let checkpoint_at = |k: u32| budget.div_f64(2f64.powi((CHECKPOINTS - 1 - k) as i32));
     let mut rows = Vec::new();
     let mut next = 0u32;
     let mut elapsed = Duration::ZERO;
-    while elapsed < budget {
+    let row = |film: &Film, checkpoint: u32, elapsed: Duration| {
+        let image = film.mean();
+        ResultRow {
+            scene: scene.scene.name.clone(),
+            strategy: strategy.name().to_string(),
+            integrand: strategy.integrand().name().to_string(),
+            backend: scene.tracer.name().to_string(),
+            threads: opts.threads,
+            run,
+            seed,
+            checkpoint,
+            time_s: elapsed.as_secs_f64(),
+            spp: film.spp,
+            rmse: rmse(&image, reference),
+            relmse: relmse(&image, reference),
+        }
+    };
+    loop {
+        if film.spp > 0 {
+            let mean_pass = elapsed.div_f64(film.spp as f64);
+            if elapsed + mean_pass > budget {
+                break;
+            }
+        }
         let start = Instant::now();
         renderer.add_pass(&mut film);
         elapsed += start.elapsed();
         on_progress(elapsed);
-        if elapsed >= checkpoint_at(next) || elapsed >= budget {
-            let image = film.mean();
-            rows.push(ResultRow {
-                scene: scene.scene.name.clone(),
-                strategy: strategy.name().to_string(),
-                integrand: strategy.integrand().name().to_string(),
-                backend: scene.tracer.name().to_string(),
-                threads: opts.threads,
-                seed: opts.seed,
-                checkpoint: next,
-                time_s: elapsed.as_secs_f64(),
-                spp: film.spp,
-                rmse: rmse(&image, reference),
-                relmse: relmse(&image, reference),
-            });
+        if next < CHECKPOINTS - 1 && elapsed >= checkpoint_at(next) {
+            rows.push(row(&film, next, elapsed));
             // One pass may cover several checkpoints; the next row is for the next one ahead.
-            while next < CHECKPOINTS && elapsed >= checkpoint_at(next) {
+            while next < CHECKPOINTS - 1 && elapsed >= checkpoint_at(next) {
                 next += 1;
             }
         }
     }
-    (film.mean(), rows)
+    // The last row is always the final image at the (bounded) budget.
+    rows.push(row(&film, CHECKPOINTS - 1, elapsed));
+    StrategyRun {
+        image: film.mean(),
+        variance: film.variance_of_mean(),
+        rows,
+        mean_sample_variance: film.mean_sample_variance(),
+    }
 }
 
 pub struct CompareReport {
     pub run_dir: PathBuf,
     pub rows: Vec<ResultRow>,
+    pub summary: Vec<SummaryRow>,
     pub skipped: Vec<Skipped>,
 }
 
-/// A reference image (and its spp) per integrand the compared strategies need.
+/// A reference image per integrand the compared strategies need.
+pub struct Reference {
+    pub integrand: Integrand,
+    pub image: Image,
+    pub spp: u64,
+    /// RMSE the reference's own noise adds to every measured RMSE (see `reference`); None
+    /// for references stored before it was tracked.
+    pub noise_floor: Option<f64>,
+}
+
 pub struct References {
-    pub images: Vec<(Integrand, Image, u64)>,
+    pub images: Vec<Reference>,
 }
 
 impl References {
-    fn get(&self, i: Integrand) -> Option<&Image> {
-        self.images
-            .iter()
-            .find(|(k, _, _)| *k == i)
-            .map(|(_, img, _)| img)
+    pub fn get(&self, i: Integrand) -> Option<&Reference> {
+        self.images.iter().find(|r| r.integrand == i)
     }
 }
 
-/// Runs `strategies` at equal time and writes `<out>/<scene>/<run-id>/`: one EXR per strategy,
-/// `results.csv` (rewritten after each strategy, so an interrupted run keeps what finished)
-/// and `run.json`.
+/// Runs `strategies` at equal time, `opts.runs` times each, and writes
+/// `<out>/<scene>/<run-id>/`: per strategy the run-0 image and its per-pixel variance of the
+/// mean (`<strategy>.exr`, `<strategy>.variance.exr`), `results.csv` (rewritten after each
+/// strategy, so an interrupted run keeps what finished), `summary.csv` and `run.json`.
 pub fn run(
     scene: &PreparedScene,
     strategies: &[Box<dyn Strategy>],
@@ -137,6 +195,9 @@ pub fn run(
             "--time must be a positive number of seconds, got {}",
             opts.time_s
         )));
+    }
+    if opts.runs == 0 {
+        return Err(Error::Usage("--runs must be at least 1".into()));
     }
     if strategies.is_empty() {
         return Err(Error::Usage(format!(
@@ -156,46 +217,74 @@ pub fn run(
         width: scene.scene.width,
         height: scene.scene.height,
         backend: scene.tracer.name(),
+        isa: &opts.isa,
         threads: opts.threads,
-        seed: opts.seed,
+        cpu_model: cpu_model(),
+        runs: opts.runs,
+        seeds: (0..opts.runs as u64).map(|k| opts.seed + k).collect(),
         budget_s: opts.time_s,
         strategies: strategies.iter().map(|s| s.name()).collect(),
         skipped: &skipped,
         reference_spp: &references
             .images
             .iter()
-            .map(|(i, _, spp)| (i.name().to_string(), *spp))
+            .map(|r| (r.integrand.name().to_string(), r.spp))
+            .collect::<Vec<_>>(),
+        reference_noise_floor: &references
+            .images
+            .iter()
+            .map(|r| (r.integrand.name().to_string(), r.noise_floor))
             .collect::<Vec<_>>(),
         dibench_version: VERSION,
+        rustc: RUSTC,
         commit: COMMIT,
     };
     write_json(&run_dir.join("run.json"), &meta)?;
     let mut rows = Vec::new();
+    let mut finals = Vec::new();
     let budget_ms = (opts.time_s * 1000.0).ceil() as u64;
-    for s in strategies {
-        let bar = progress_bar(
-            budget_ms,
-            format!("{:<10}", s.name()),
-            "{prefix} [{bar:30}] {msg}",
-        );
-        let reference = references.get(s.integrand()).ok_or_else(|| {
-            Error::Usage(format!(
-                "no {} reference for strategy `{}`",
-                s.integrand().name(),
-                s.name()
-            ))
-        })?;
-        let (image, mut r) = run_strategy(scene, s.as_ref(), reference, opts, |t| {
-            bar.set_position(t.as_millis() as u64);
-        });
-        bar.finish_and_clear();
-        write_exr(&run_dir.join(format!("{}.exr", s.name())), &image)?;
-        rows.append(&mut r);
-        write_csv(&run_dir.join("results.csv"), &rows)?;
+    // Strategies interleaved within each run, so slow drifts in machine load spread over all.
+    for run in 0..opts.runs {
+        for s in strategies {
+            let bar = progress_bar(
+                budget_ms,
+                format!("run {run} {:<10}", s.name()),
+                "{prefix} [{bar:30}] {msg}",
+            );
+            let reference = references.get(s.integrand()).ok_or_else(|| {
+                Error::Usage(format!(
+                    "no {} reference for strategy `{}`",
+                    s.integrand().name(),
+                    s.name()
+                ))
+            })?;
+            let r = run_strategy(scene, s.as_ref(), &reference.image, opts, run, |t| {
+                bar.set_position(t.as_millis() as u64);
+            });
+            bar.finish_and_clear();
+            if run == 0 {
+                write_exr(&run_dir.join(format!("{}.exr", s.name())), &r.image)?;
+                write_exr(
+                    &run_dir.join(format!("{}.variance.exr", s.name())),
+                    &r.variance,
+                )?;
+            }
+            let last = r.rows.last().cloned().expect("a run has a final row");
+            finals.push(FinalRun {
+                row: last,
+                mean_sample_variance: r.mean_sample_variance,
+                reference_noise_floor: reference.noise_floor,
+            });
+            rows.extend(r.rows);
+            write_csv(&run_dir.join("results.csv"), &rows)?;
+        }
     }
+    let summary = summarize(&finals, opts.time_s);
+    write_csv(&run_dir.join("summary.csv"), &summary)?;
     Ok(CompareReport {
         run_dir,
         rows,
+        summary,
         skipped,
     })
 }

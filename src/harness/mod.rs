@@ -5,6 +5,7 @@ pub mod crosscheck;
 pub mod rays;
 pub mod raysets;
 pub mod reference;
+pub mod summary;
 
 use crate::film::{Film, Image};
 use crate::render::Renderer;
@@ -12,6 +13,20 @@ use crate::render::Renderer;
 /// Build provenance written into every metadata file.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 pub const COMMIT: &str = env!("DIBENCH_COMMIT");
+pub const RUSTC: &str = env!("DIBENCH_RUSTC");
+
+/// The CPU model from /proc/cpuinfo, or `unknown` where there is none (non-Linux).
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
 
 /// Renders `spp` passes with a renderer; the single place where whole images are made.
 pub fn render_spp(

@@ -1,9 +1,9 @@
 //! High-sample reference images, stored with the metadata that decides whether `compare` may
 //! reuse them: same scene content hash and resolution, and at least the requested spp.
 
-use super::{COMMIT, VERSION, progress_bar, render_spp};
+use super::{COMMIT, VERSION, progress_bar};
 use crate::error::{Error, Result};
-use crate::film::Image;
+use crate::film::{Film, Image};
 use crate::math::mix64;
 use crate::output::{read_exr, write_exr, write_json};
 use crate::prepare::PreparedScene;
@@ -11,7 +11,7 @@ use crate::render::Renderer;
 use crate::strategy::{Integrand, reference_strategy};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ReferenceMeta {
@@ -26,6 +26,11 @@ pub struct ReferenceMeta {
     pub backend: String,
     pub threads: usize,
     pub wall_time_s: f64,
+    /// √(mean over pixels and channels of the variance of the reference mean): the RMSE the
+    /// reference's own noise adds to any image's measured RMSE (in expectation,
+    /// E[RMSE²] = MSE against the truth + floor²). Absent in references stored before.
+    #[serde(default)]
+    pub noise_floor_rmse: Option<f64>,
     pub dibench_version: String,
     pub commit: String,
 }
@@ -41,16 +46,55 @@ fn reference_stream_seed(seed: u64) -> u64 {
     mix64(seed) ^ 0x5245_4645_5245_4e43
 }
 
+/// How long a reference renders.
+#[derive(Clone, Copy, Debug)]
+pub enum Budget {
+    Spp(u64),
+    /// Whole passes until the time is spent (at least one).
+    Time(f64),
+}
+
+/// The first progressive checkpoint; later ones at 2×, 4×, ... (a crash loses at most half).
+pub const FIRST_CHECKPOINT_SPP: u64 = 64;
+
+/// A rendered reference: mean image, per-pixel variance of the mean, metadata.
+pub struct Rendered {
+    pub image: Image,
+    pub variance: Image,
+    pub meta: ReferenceMeta,
+}
+
 pub fn render(
     scene: &PreparedScene,
     integrand: Integrand,
     spp: u64,
     seed: u64,
     threads: usize,
-) -> Result<(Image, ReferenceMeta)> {
-    if spp == 0 {
-        return Err(Error::Usage("--spp must be at least 1".into()));
-    }
+) -> Result<Rendered> {
+    render_progressive(scene, integrand, Budget::Spp(spp), seed, threads, None)
+}
+
+/// Renders a reference; with `checkpoint_out`, saves it (image, variance, JSON) at 64, 128,
+/// 256, ... spp so an interrupted render keeps its latest power of two. A stored checkpoint
+/// carries its own spp, so `compare` reuses it only when that is enough.
+pub fn render_progressive(
+    scene: &PreparedScene,
+    integrand: Integrand,
+    budget: Budget,
+    seed: u64,
+    threads: usize,
+    checkpoint_out: Option<&Path>,
+) -> Result<Rendered> {
+    let (spp, time) = match budget {
+        Budget::Spp(0) => return Err(Error::Usage("--spp must be at least 1".into())),
+        Budget::Spp(n) => (n, None),
+        Budget::Time(t) if !(t.is_finite() && t > 0.0) => {
+            return Err(Error::Usage(format!(
+                "--time must be a positive number of seconds, got {t}"
+            )));
+        }
+        Budget::Time(t) => (u64::MAX, Some(Duration::from_secs_f64(t))),
+    };
     let strategy = reference_strategy(scene, integrand).ok_or_else(|| {
         Error::Usage(format!(
             "scene `{}`: no strategy can render a {} reference",
@@ -60,41 +104,64 @@ pub fn render(
     })?;
     let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
     let bar = progress_bar(
-        spp,
+        if time.is_some() { 0 } else { spp },
         format!("reference {} {}", scene.scene.name, integrand.name()),
         "{prefix} [{bar:30}] {pos}/{len} spp, eta {eta}",
     );
     let start = Instant::now();
-    let image = render_spp(
-        &renderer,
-        scene.scene.width,
-        scene.scene.height,
-        spp,
-        |_| bar.inc(1),
-    );
-    bar.finish_and_clear();
-    let meta = ReferenceMeta {
+    let mut film = Film::new(scene.scene.width, scene.scene.height);
+    let meta_of = |film: &Film| ReferenceMeta {
         scene: scene.scene.name.clone(),
         integrand: integrand.name().to_string(),
         scene_hash: scene.scene.content_hash.clone(),
         width: scene.scene.width,
         height: scene.scene.height,
-        spp,
+        spp: film.spp,
         seed,
         strategy: strategy.name().to_string(),
         backend: scene.tracer.name().to_string(),
         threads,
         wall_time_s: start.elapsed().as_secs_f64(),
+        noise_floor_rmse: Some((film.mean_sample_variance() / film.spp as f64).sqrt()),
         dibench_version: VERSION.to_string(),
         commit: COMMIT.to_string(),
     };
-    Ok((image, meta))
+    let mut next_checkpoint = FIRST_CHECKPOINT_SPP;
+    loop {
+        let done = match time {
+            Some(t) => film.spp > 0 && start.elapsed() >= t,
+            None => film.spp >= spp,
+        };
+        if done {
+            break;
+        }
+        renderer.add_pass(&mut film);
+        bar.inc(1);
+        if let Some(out) = checkpoint_out
+            && film.spp == next_checkpoint
+        {
+            save(out, &film.mean(), &film.variance_of_mean(), &meta_of(&film))?;
+            next_checkpoint *= 2;
+        }
+    }
+    bar.finish_and_clear();
+    Ok(Rendered {
+        image: film.mean(),
+        variance: film.variance_of_mean(),
+        meta: meta_of(&film),
+    })
 }
 
-pub fn save(out: &Path, image: &Image, meta: &ReferenceMeta) -> Result<PathBuf> {
+/// Writes `<integrand>.exr`, its per-pixel variance of the mean `<integrand>.variance.exr`,
+/// and `<integrand>.json`; the JSON last, so a stored JSON always describes its images.
+pub fn save(out: &Path, image: &Image, variance: &Image, meta: &ReferenceMeta) -> Result<PathBuf> {
     let dir = reference_dir(out, &meta.scene);
     let exr = dir.join(format!("{}.exr", meta.integrand));
     write_exr(&exr, image)?;
+    write_exr(
+        &dir.join(format!("{}.variance.exr", meta.integrand)),
+        variance,
+    )?;
     write_json(&dir.join(format!("{}.json", meta.integrand)), meta)?;
     Ok(exr)
 }

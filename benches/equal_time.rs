@@ -1,0 +1,90 @@
+//! The equal-time comparison on the bench scenes as a bench target: `cargo bench --bench
+//! equal_time` renders a reference per scene, runs every applicable strategy
+//! DIBENCH_BENCH_RUNS times (default 5) for DIBENCH_BENCH_TIME seconds (default 0.25) on the
+//! packet backend, writes the run directories (results.csv, summary.csv) under
+//! target/tmp/equal_time/, and prints each strategy's predicted equal-time RMSE
+//! (per-sample variance × cost per sample / budget, plus the reference noise floor) beside the
+//! measured one with its 95 % interval.
+
+use dibench::harness::{compare, reference};
+use dibench::prepare::PreparedScene;
+use dibench::scene::Scene;
+use dibench::strategy::{applicable, integrands};
+use dibench::tracer::backends;
+use std::path::PathBuf;
+
+const SCENES: [&str; 2] = ["cornell", "sphere_light"];
+const REFERENCE_SPP: u64 = 2048;
+
+fn env_or<T: std::str::FromStr>(key: &str, default: T) -> T {
+    std::env::var(key)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    // `cargo bench` passes --bench; `cargo test --benches` passes nothing and expects speed.
+    if !std::env::args().any(|a| a == "--bench") {
+        return Ok(());
+    }
+    let time_s: f64 = env_or("DIBENCH_BENCH_TIME", 0.25);
+    let runs: u32 = env_or("DIBENCH_BENCH_RUNS", 5);
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("equal_time");
+    let threads = rayon::current_num_threads();
+    for name in SCENES {
+        let scene = Scene::load(&Scene::resolve(name)?)?;
+        let scene = PreparedScene::with_tracer(scene, |g| {
+            backends::build("packet", g).expect("the packet backend always builds")
+        });
+        let (strategies, skipped) = applicable(&scene);
+        for k in &skipped {
+            eprintln!("{name}: skipping `{}`: {}", k.name, k.reason);
+        }
+        let mut images = Vec::new();
+        for integrand in integrands(&scene) {
+            let stored = reference::load_matching(&out, &scene, integrand, REFERENCE_SPP)?;
+            let (image, meta) = match stored {
+                Some(r) => r,
+                None => {
+                    let r = reference::render(&scene, integrand, REFERENCE_SPP, 1, threads)?;
+                    reference::save(&out, &r.image, &r.variance, &r.meta)?;
+                    (r.image, r.meta)
+                }
+            };
+            images.push(compare::Reference {
+                integrand,
+                image,
+                spp: meta.spp,
+                noise_floor: meta.noise_floor_rmse,
+            });
+        }
+        let opts = compare::CompareOptions {
+            time_s,
+            seed: 1,
+            threads,
+            runs,
+            isa: dibench::simd::Isa::detect()?.name().to_string(),
+        };
+        let references = compare::References { images };
+        let report = compare::run(&scene, &strategies, skipped, &references, &out, &opts)?;
+        println!(
+            "equal_time/{name}: {runs} runs × {time_s} s, {}",
+            report.run_dir.display()
+        );
+        println!(
+            "  {:<18} {:>12} {:>12} {:>10}",
+            "strategy", "predicted", "measured", "±95%"
+        );
+        for r in &report.summary {
+            println!(
+                "  {:<18} {:>12.4e} {:>12.4e} {:>10.2e}",
+                r.strategy,
+                r.predicted_rmse,
+                r.rmse_mean,
+                r.rmse_ci95.unwrap_or(0.0)
+            );
+        }
+    }
+    Ok(())
+}

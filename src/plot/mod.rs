@@ -1,0 +1,413 @@
+//! `dibench plot RUN_DIR`: figures from a compare run directory, written to `RUN_DIR/plots/`:
+//! - `rmse_vs_time.png` / `.svg`: log-log RMSE against render time per strategy, mean over
+//!   runs with the 95 % Student-t band, and a slope −½ guide (RMSE ∝ t^−½ for an unbiased
+//!   estimator at constant cost per sample);
+//! - `variance.png`: per-pixel variance of the mean (`<strategy>.variance.exr`, mean of the RGB
+//!   channels), log10 on one shared scale with a colour bar;
+//! - `strip.png`: the equal-time images (run 0) side by side, clamped to [0, 1] and sRGB-encoded.
+//!
+//! Text uses the vendored DejaVu Sans (assets/fonts), so no system font library is needed.
+//! The two image figures are PNG only: an SVG of them would be one rectangle per pixel.
+
+use crate::error::{Error, Result};
+use crate::film::Image;
+use crate::harness::compare::ResultRow;
+use crate::output::{read_exr, write_bytes};
+use crate::stats::mean_ci;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+fn register_font() -> Result<()> {
+    static ONCE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *ONCE.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, FONT).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::Usage("cannot load the embedded plot font".into()))
+    }
+}
+
+fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Output {
+        path: path.into(),
+        message: format!("cannot draw the plot: {e}"),
+    }
+}
+
+/// One strategy's curve: per checkpoint, mean time, mean RMSE and CI half-width (if ≥ 2 runs).
+struct Curve {
+    label: String,
+    points: Vec<(f64, f64, Option<f64>)>,
+}
+
+fn curves(rows: &[ResultRow]) -> Vec<Curve> {
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for r in rows {
+        let k = (r.strategy.clone(), r.integrand.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    keys.into_iter()
+        .map(|(strategy, integrand)| {
+            let mine: Vec<&ResultRow> = rows
+                .iter()
+                .filter(|r| r.strategy == strategy && r.integrand == integrand)
+                .collect();
+            let mut cps: Vec<u32> = mine.iter().map(|r| r.checkpoint).collect();
+            cps.sort_unstable();
+            cps.dedup();
+            let points = cps
+                .iter()
+                .map(|&c| {
+                    let at: Vec<&&ResultRow> = mine.iter().filter(|r| r.checkpoint == c).collect();
+                    let t = at.iter().map(|r| r.time_s).sum::<f64>() / at.len() as f64;
+                    let rmse: Vec<f64> = at.iter().map(|r| r.rmse).collect();
+                    let ci = mean_ci(&rmse, crate::harness::summary::LEVEL);
+                    (t, ci.mean, ci.half_width)
+                })
+                .collect();
+            Curve {
+                label: if integrand == "direct" {
+                    strategy
+                } else {
+                    format!("{strategy} ({integrand})")
+                },
+                points,
+            }
+        })
+        .collect()
+}
+
+fn draw_rmse<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, curves: &[Curve]) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| plot_err(Path::new("rmse_vs_time"), e);
+    root.fill(&WHITE).map_err(e)?;
+    let all = curves.iter().flat_map(|c| c.points.iter());
+    let (mut t0, mut t1, mut y0, mut y1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for &(t, y, _) in all {
+        t0 = t0.min(t);
+        t1 = t1.max(t);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if !(t0 > 0.0 && y0 > 0.0 && t1 > t0) {
+        return Err(plot_err(Path::new("rmse_vs_time"), "no positive data"));
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "RMSE against render time (mean, 95 % CI)",
+            ("sans-serif", 22),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(
+            (t0 / 1.3..t1 * 1.3).log_scale(),
+            (y0 / 2.0..y1 * 2.0).log_scale(),
+        )
+        .map_err(e)?;
+    chart
+        .configure_mesh()
+        .x_desc("time [s]")
+        .y_desc("RMSE")
+        .x_labels(6)
+        .y_labels(6)
+        .light_line_style(WHITE)
+        .label_style(("sans-serif", 14))
+        .x_label_formatter(&|x| format!("{x:.1e}"))
+        .y_label_formatter(&|y| format!("{y:.1e}"))
+        .draw()
+        .map_err(e)?;
+    for (i, c) in curves.iter().enumerate() {
+        let colour = Palette99::pick(i).to_rgba();
+        // The band's lower edge is drawn at the bottom of the axis where mean − CI ≤ 0.
+        let band: Vec<(f64, f64)> = c
+            .points
+            .iter()
+            .filter_map(|&(t, y, h)| h.map(|h| (t, y + h)))
+            .chain(
+                c.points
+                    .iter()
+                    .rev()
+                    .filter_map(|&(t, y, h)| h.map(|h| (t, (y - h).max(y0 / 2.0)))),
+            )
+            .collect();
+        if band.len() >= 4 {
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    band,
+                    colour.mix(0.2).filled(),
+                )))
+                .map_err(e)?;
+        }
+        chart
+            .draw_series(LineSeries::new(
+                c.points.iter().map(|&(t, y, _)| (t, y)),
+                colour.stroke_width(2),
+            ))
+            .map_err(e)?
+            .label(c.label.clone())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(2)));
+    }
+    // Slope −½ guide through the lowest curve's first point.
+    if let Some(&(ta, ya, _)) = curves
+        .iter()
+        .filter_map(|c| c.points.first())
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+    {
+        let guide = [(ta, ya * 0.7), (t1, ya * 0.7 * (ta / t1).sqrt())];
+        chart
+            .draw_series(DashedLineSeries::new(guide, 6, 4, BLACK.stroke_width(1)))
+            .map_err(e)?
+            .label("slope −½")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], BLACK));
+    }
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", 13))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerLeft)
+        .draw()
+        .map_err(e)?;
+    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Encodes an RGB8 buffer as PNG and writes it atomically.
+fn write_png(path: &Path, (w, h): (u32, u32), rgb: &[u8]) -> Result<()> {
+    let mut bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut bytes, w, h);
+        enc.set_color(png::ColorType::Rgb);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut writer = enc.write_header().map_err(|e| plot_err(path, e))?;
+        writer
+            .write_image_data(rgb)
+            .map_err(|e| plot_err(path, e))?;
+    }
+    write_bytes(path, &bytes)
+}
+
+/// Renders a figure into an RGB buffer with `draw`, then writes it as PNG.
+fn png_figure(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+) -> Result<()> {
+    let mut buf = vec![0u8; (size.0 * size.1 * 3) as usize];
+    draw(BitMapBackend::with_buffer(&mut buf, size).into_drawing_area())?;
+    write_png(path, size, &buf)
+}
+
+fn svg_figure(
+    path: &Path,
+    size: (u32, u32),
+    draw: impl FnOnce(DrawingArea<SVGBackend, Shift>) -> Result<()>,
+) -> Result<()> {
+    let mut text = String::new();
+    draw(SVGBackend::with_string(&mut text, size).into_drawing_area())?;
+    write_bytes(path, text.as_bytes())
+}
+
+/// The images a figure shows, one per strategy, in results.csv order.
+fn strategy_images(run_dir: &Path, names: &[String], suffix: &str) -> Result<Vec<(String, Image)>> {
+    names
+        .iter()
+        .map(|n| {
+            Ok((
+                n.clone(),
+                read_exr(&run_dir.join(format!("{n}{suffix}.exr")))?,
+            ))
+        })
+        .collect()
+}
+
+const SCALE: u32 = 2;
+const LABEL_H: u32 = 26;
+const GAP: u32 = 8;
+
+/// Draws images side by side with a caption above each; `colour(x, y)` per image pixel.
+fn draw_tiles(
+    root: &DrawingArea<BitMapBackend, Shift>,
+    images: &[(String, Image)],
+    colour: impl Fn(&Image, u32, u32) -> RGBColor,
+) -> Result<()> {
+    let e = |e| plot_err(Path::new("tiles"), e);
+    let mut x0 = GAP as i32;
+    for (name, img) in images {
+        root.draw(&Text::new(
+            name.clone(),
+            (x0, 4),
+            ("sans-serif", 16).into_font().color(&BLACK),
+        ))
+        .map_err(e)?;
+        for y in 0..img.height {
+            for x in 0..img.width {
+                let c = colour(img, x, y);
+                for dy in 0..SCALE {
+                    for dx in 0..SCALE {
+                        root.draw_pixel(
+                            (
+                                x0 + (x * SCALE + dx) as i32,
+                                (LABEL_H + y * SCALE + dy) as i32,
+                            ),
+                            &c,
+                        )
+                        .map_err(e)?;
+                    }
+                }
+            }
+        }
+        x0 += (img.width * SCALE + GAP) as i32;
+    }
+    Ok(())
+}
+
+fn srgb8(v: f64) -> u8 {
+    let v = v.clamp(0.0, 1.0);
+    let s = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0).round() as u8
+}
+
+fn viridis(t: f64) -> RGBColor {
+    let c = colorous::VIRIDIS.eval_continuous(t.clamp(0.0, 1.0));
+    RGBColor(c.r, c.g, c.b)
+}
+
+fn mean_channel(img: &Image, x: u32, y: u32) -> f64 {
+    let p = img.pixels[(y * img.width + x) as usize];
+    (p[0] + p[1] + p[2]) / 3.0
+}
+
+/// Writes every figure for `run_dir` into `run_dir/plots/` and returns their paths.
+pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
+    register_font()?;
+    let csv_path = run_dir.join("results.csv");
+    let mut reader = csv::Reader::from_path(&csv_path).map_err(|e| Error::Parse {
+        path: csv_path.clone(),
+        message: e.to_string(),
+    })?;
+    let rows: Vec<ResultRow> = reader
+        .deserialize()
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| Error::Parse {
+            path: csv_path.clone(),
+            message: e.to_string(),
+        })?;
+    if rows.is_empty() {
+        return Err(Error::Parse {
+            path: csv_path,
+            message: "no result rows".into(),
+        });
+    }
+    let dir = run_dir.join("plots");
+    let mut written = Vec::new();
+
+    let c = curves(&rows);
+    let size = (900, 620);
+    let p = dir.join("rmse_vs_time.png");
+    png_figure(&p, size, |root| draw_rmse(root, &c))?;
+    written.push(p);
+    let p = dir.join("rmse_vs_time.svg");
+    svg_figure(&p, size, |root| draw_rmse(root, &c))?;
+    written.push(p);
+
+    let mut names: Vec<String> = Vec::new();
+    for r in &rows {
+        if !names.contains(&r.strategy) {
+            names.push(r.strategy.clone());
+        }
+    }
+    let images = strategy_images(run_dir, &names, "")?;
+    let (w, h) = (images[0].1.width, images[0].1.height);
+    let strip_size = (
+        GAP + images.len() as u32 * (w * SCALE + GAP),
+        LABEL_H + h * SCALE + GAP,
+    );
+    let p = dir.join("strip.png");
+    png_figure(&p, strip_size, |root| {
+        root.fill(&WHITE).map_err(|e| plot_err(&p, e))?;
+        draw_tiles(&root, &images, |img, x, y| {
+            let q = img.pixels[(y * img.width + x) as usize];
+            RGBColor(srgb8(q[0]), srgb8(q[1]), srgb8(q[2]))
+        })
+    })?;
+    written.push(p);
+
+    let variances = strategy_images(run_dir, &names, ".variance")?;
+    // One log10 scale over all strategies: the 1st to 99.9th percentile of the positive
+    // values, so a few near-zero pixels (light edges) do not stretch the scale; values outside
+    // take the ends of the colour bar.
+    let mut logs: Vec<f64> = variances
+        .iter()
+        .flat_map(|(_, img)| img.pixels.iter().map(|p| (p[0] + p[1] + p[2]) / 3.0))
+        .filter(|&v| v > 0.0)
+        .map(f64::log10)
+        .collect();
+    logs.sort_by(f64::total_cmp);
+    let (lo, hi) = if logs.is_empty() {
+        (0.0, 1.0)
+    } else {
+        let q = |f: f64| logs[((logs.len() - 1) as f64 * f) as usize];
+        (q(0.01), q(0.999))
+    };
+    let span = (hi - lo).max(1e-9);
+    const BAR_W: u32 = 110;
+    let var_size = (strip_size.0 + BAR_W, strip_size.1 + 30);
+    let p = dir.join("variance.png");
+    png_figure(&p, var_size, |root| {
+        let e = |e| plot_err(&p, e);
+        root.fill(&WHITE).map_err(e)?;
+        // Zero-variance pixels (e.g. the background) take the bottom of the scale.
+        draw_tiles(&root, &variances, |img, x, y| {
+            let v = mean_channel(img, x, y);
+            viridis(if v > 0.0 {
+                (v.log10() - lo) / span
+            } else {
+                0.0
+            })
+        })?;
+        let bx = strip_size.0 as i32 + 4;
+        let (top, bottom) = (LABEL_H as i32, (LABEL_H + h * SCALE) as i32);
+        for y in top..bottom {
+            let t = (bottom - y) as f64 / (bottom - top) as f64;
+            root.draw(&Rectangle::new(
+                [(bx, y), (bx + 16, y + 1)],
+                viridis(t).filled(),
+            ))
+            .map_err(e)?;
+        }
+        for k in 0..=4 {
+            let t = k as f64 / 4.0;
+            let y = bottom - ((bottom - top) as f64 * t) as i32;
+            root.draw(&Text::new(
+                format!("{:.1e}", 10f64.powf(lo + t * span)),
+                (bx + 20, y - 7),
+                ("sans-serif", 13).into_font().color(&BLACK),
+            ))
+            .map_err(e)?;
+        }
+        root.draw(&Text::new(
+            "per-pixel variance of the mean (log scale, mean of RGB)",
+            (GAP as i32, (LABEL_H + h * SCALE + 10) as i32),
+            ("sans-serif", 14).into_font().color(&BLACK),
+        ))
+        .map_err(e)?;
+        Ok(())
+    })?;
+    written.push(p);
+    Ok(written)
+}

@@ -1,0 +1,261 @@
+//! The rigor harness through the CLI: repeated runs with summary.csv, variance images, run
+//! metadata, reference noise floor and checkpoints, plots, and errors for bad arguments.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A quad light over a floor with a sphere: light and direction strategies both apply, and
+/// an [ambient_occlusion] section adds the AO integrand.
+const SCENE: &str = r#"
+[camera]
+eye = [0.0, 1.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y_deg = 40.0
+[image]
+width = 16
+height = 12
+[[material]]
+name = "m"
+albedo = [0.5, 0.5, 0.5]
+[[quad]]
+corner = [-3.0, 0.0, -3.0]
+edge_u = [0.0, 0.0, 6.0]
+edge_v = [6.0, 0.0, 0.0]
+material = "m"
+[[quad]]
+corner = [-0.5, 1.5, -0.5]
+edge_u = [1.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, 1.0]
+material = "m"
+emission = [4.0, 4.0, 4.0]
+[[sphere]]
+center = [0.3, 0.3, 0.0]
+radius = 0.3
+material = "m"
+[ambient_occlusion]
+distance = 0.5
+"#;
+
+fn dibench(args: &[&str], cwd: &Path) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_dibench"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(
+        !stderr.contains("panicked"),
+        "dibench {args:?} panicked: {stderr}"
+    );
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr,
+    )
+}
+
+fn run_dirs(scene_dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(scene_dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| !p.ends_with("reference"))
+        .collect()
+}
+
+#[test]
+fn compare_runs_writes_summary_variance_metadata_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let (code, stdout, stderr) = dibench(
+        &[
+            "compare",
+            "tiny.toml",
+            "--runs",
+            "3",
+            "--time",
+            "0.05",
+            "--reference-spp",
+            "256",
+            "--strategies",
+            "light,cosine,ao-cosine",
+            "--threads",
+            "1",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("noise floor"), "{stdout}");
+    let runs = run_dirs(&dir.path().join("out/tiny"));
+    assert_eq!(runs.len(), 1);
+    let run = &runs[0];
+
+    let results = std::fs::read_to_string(run.join("results.csv")).unwrap();
+    for k in 0..3 {
+        let seed = 1 + k;
+        assert!(
+            results.lines().any(
+                |l| l.contains(&format!(",light,direct,packet,1,{k},{seed},7,"))
+                    || l.contains(&format!(",{k},{seed},7,"))
+            ),
+            "no final row for run {k}:\n{results}"
+        );
+    }
+
+    let summary = std::fs::read_to_string(run.join("summary.csv")).unwrap();
+    let mut lines = summary.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "scene,integrand,strategy,runs,budget_s,time_s_mean,overshoot_max,spp_mean,rmse_mean,\
+         rmse_ci95,relmse_mean,relmse_ci95,efficiency,predicted_rmse,reference_noise_floor,\
+         welch_p_vs_best,vs_best"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 3, "{summary}");
+    for r in &rows {
+        assert_eq!(r[3], "3", "runs: {summary}");
+        let ci: f64 = r[9].parse().expect("an RMSE CI with 3 runs");
+        assert!(ci.is_finite() && ci >= 0.0);
+        let floor: f64 = r[14].parse().expect("a reference noise floor");
+        assert!(floor > 0.0 && floor.is_finite());
+    }
+    // One best per integrand: light vs cosine for direct, ao-cosine alone for AO.
+    let best: Vec<_> = rows
+        .iter()
+        .filter(|r| r[16] == "best")
+        .map(|r| r[2])
+        .collect();
+    assert_eq!(best.len(), 2, "{summary}");
+    assert!(best.contains(&"ao-cosine"));
+
+    for s in ["light", "cosine", "ao-cosine"] {
+        for suffix in ["", ".variance"] {
+            assert!(
+                run.join(format!("{s}{suffix}.exr")).is_file(),
+                "{s}{suffix}.exr"
+            );
+        }
+    }
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run.join("run.json")).unwrap()).unwrap();
+    for key in [
+        "commit",
+        "cpu_model",
+        "isa",
+        "threads",
+        "backend",
+        "seeds",
+        "budget_s",
+        "rustc",
+    ] {
+        assert!(meta.get(key).is_some(), "run.json lacks {key}: {meta}");
+    }
+    assert_eq!(meta["seeds"], serde_json::json!([1, 2, 3]));
+
+    let (code, stdout, stderr) = dibench(&["plot", run.to_str().unwrap()], dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    for f in [
+        "rmse_vs_time.png",
+        "rmse_vs_time.svg",
+        "strip.png",
+        "variance.png",
+    ] {
+        let p = run.join("plots").join(f);
+        assert!(std::fs::metadata(&p).unwrap().len() > 1000, "{f} empty");
+        assert!(stdout.contains(f));
+    }
+    let png = std::fs::read(run.join("plots/strip.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+}
+
+/// The reference's noise floor predicts the RMSE between two independent references:
+/// E[RMSE²(a, b)] = floor_a² + floor_b². Checked with the spread of the per-pixel terms as
+/// the tolerance (z ≤ 4.4 over 16·12·3 pixel-channels).
+#[test]
+fn reference_noise_floor_predicts_the_difference_of_two_references() {
+    use dibench::output::read_exr;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let mut images = Vec::new();
+    let mut floors = Vec::new();
+    for seed in ["1", "2"] {
+        let out = format!("out{seed}");
+        let (code, _, stderr) = dibench(
+            &[
+                "reference",
+                "tiny.toml",
+                "--spp",
+                "200",
+                "--seed",
+                seed,
+                "--threads",
+                "1",
+                "--out",
+                &out,
+            ],
+            dir.path(),
+        );
+        assert_eq!(code, 0, "{stderr}");
+        let refdir = dir.path().join(&out).join("tiny/reference");
+        let meta: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(refdir.join("direct.json")).unwrap())
+                .unwrap();
+        assert_eq!(
+            meta["spp"], 200,
+            "the final save replaces the 64 and 128 spp checkpoints"
+        );
+        floors.push(meta["noise_floor_rmse"].as_f64().unwrap());
+        images.push(read_exr(&refdir.join("direct.exr")).unwrap());
+        assert!(refdir.join("direct.variance.exr").is_file());
+    }
+    let d2: Vec<f64> = images[0]
+        .pixels
+        .iter()
+        .zip(&images[1].pixels)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).powi(2)))
+        .collect();
+    let n = d2.len() as f64;
+    let mean = d2.iter().sum::<f64>() / n;
+    let sd = (d2.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+    let expected = floors[0].powi(2) + floors[1].powi(2);
+    let z = (mean - expected) / (sd / n.sqrt());
+    assert!(
+        z.abs() < 4.4,
+        "MSE {mean:.4e} vs predicted {expected:.4e}, z = {z:.2}"
+    );
+}
+
+#[test]
+fn bad_harness_arguments_are_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let cases: [(&[&str], &str); 4] = [
+        (
+            &["compare", "tiny.toml", "--runs", "0", "--out", "o"],
+            "--runs",
+        ),
+        (
+            &["reference", "tiny.toml", "--time", "0", "--out", "o"],
+            "--time",
+        ),
+        (
+            &["reference", "tiny.toml", "--spp", "0", "--out", "o"],
+            "--spp",
+        ),
+        (&["plot", "no_such_dir"], "results.csv"),
+    ];
+    for (args, needle) in cases {
+        let (code, _, stderr) = dibench(args, dir.path());
+        assert_ne!(code, 0, "{args:?} succeeded");
+        assert!(
+            stderr.contains(needle),
+            "{args:?}: `{stderr}` lacks `{needle}`"
+        );
+    }
+    assert!(
+        !dir.path().join("o").exists(),
+        "a failed run left output behind"
+    );
+}
