@@ -359,6 +359,8 @@ fn run_stress(a: StressArgs) -> Result<()> {
 }
 
 fn run_reference(a: ReferenceArgs) -> Result<()> {
+    // Ctrl-C stops between passes and keeps what is complete (see `interrupt`).
+    crate::interrupt::install();
     let (pool, threads) = pool(a.common.threads)?;
     let scene = load_with(&a.common)?;
     let budget = match (a.spp, a.time) {
@@ -390,6 +392,8 @@ fn run_reference(a: ReferenceArgs) -> Result<()> {
 }
 
 fn run_compare(a: CompareArgs) -> Result<()> {
+    // Ctrl-C stops between passes and keeps what is complete (see `interrupt`).
+    crate::interrupt::install();
     let (pool, threads) = pool(a.common.threads)?;
     if !(a.time.is_finite() && a.time > 0.0) {
         return Err(Error::Usage(format!(

@@ -22,6 +22,9 @@ pub enum Error {
     Usage(String),
     #[error("{path}: {message}")]
     Output { path: PathBuf, message: String },
+    /// Ctrl-C or SIGTERM: the command stopped early after writing what was complete.
+    #[error("interrupted: {0}")]
+    Interrupted(String),
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

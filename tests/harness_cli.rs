@@ -259,3 +259,94 @@ fn bad_harness_arguments_are_errors() {
         "a failed run left output behind"
     );
 }
+
+/// Ctrl-C during `compare`: the command stops between passes, exits 130, keeps the strategy
+/// runs that finished (results.csv, their EXRs, a summary) and records the interruption in
+/// run.json; the unfinished strategy leaves nothing, and no temp file is left behind.
+#[test]
+fn ctrl_c_keeps_finished_strategies_and_exits_130() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_dibench"))
+        .args([
+            "compare",
+            "tiny.toml",
+            "--time",
+            "1.5",
+            "--reference-spp",
+            "64",
+            "--strategies",
+            "light,cosine",
+            "--threads",
+            "1",
+            "--out",
+            "out",
+        ])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the first strategy's rows, then interrupt the second one (1.5 s long).
+    let scene_dir = dir.path().join("out/tiny");
+    let start = std::time::Instant::now();
+    let run = loop {
+        assert!(start.elapsed().as_secs() < 60, "no results.csv after 60 s");
+        if scene_dir.exists()
+            && let Some(r) = run_dirs(&scene_dir)
+                .into_iter()
+                .find(|r| r.join("results.csv").exists())
+        {
+            break r;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    };
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted"), "{stderr}");
+
+    let meta = std::fs::read_to_string(run.join("run.json")).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(&meta).unwrap();
+    assert_eq!(meta["interrupted"], true);
+    let completed = meta["completed"].as_array().unwrap();
+    assert_eq!(completed.len(), 1, "{meta}");
+    let done = completed[0][0].as_str().unwrap();
+    let other = if done == "light" { "cosine" } else { "light" };
+    let results = std::fs::read_to_string(run.join("results.csv")).unwrap();
+    assert!(results.lines().count() > 1);
+    assert!(
+        results
+            .lines()
+            .skip(1)
+            .all(|l| l.contains(&format!(",{done},"))),
+        "{results}"
+    );
+    assert!(run.join(format!("{done}.exr")).exists());
+    assert!(run.join(format!("{done}.variance.exr")).exists());
+    assert!(!run.join(format!("{other}.exr")).exists());
+    let summary = std::fs::read_to_string(run.join("summary.csv")).unwrap();
+    assert_eq!(summary.lines().count(), 2, "{summary}");
+    for e in walk(dir.path()) {
+        let name = e.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(!name.contains(".tmp"), "temp file left: {}", e.display());
+    }
+}
+
+fn walk(p: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(p).unwrap().flatten() {
+        let path = e.path();
+        if path.is_dir() {
+            out.extend(walk(&path));
+        }
+        out.push(path);
+    }
+    out
+}

@@ -69,6 +69,10 @@ struct RunMeta<'a> {
     dibench_version: &'a str,
     rustc: &'a str,
     commit: &'a str,
+    /// Set (and run.json rewritten) when Ctrl-C stopped the run: only `completed` (strategy,
+    /// run) pairs are in results.csv and summary.csv.
+    interrupted: bool,
+    completed: Vec<(String, u32)>,
 }
 
 /// What one strategy's run leaves: the mean and variance images, the rows, and the final
@@ -78,6 +82,9 @@ pub struct StrategyRun {
     pub variance: Image,
     pub rows: Vec<ResultRow>,
     pub mean_sample_variance: f64,
+    /// An interrupt arrived before the budget was spent: the run is incomplete and must be
+    /// discarded (its error is not comparable with the others').
+    pub interrupted: bool,
 }
 
 /// One strategy's equal-time run with seed `seed`: passes while the next one is predicted to
@@ -105,6 +112,7 @@ pub fn run_strategy(
     let mut rows = Vec::new();
     let mut next = 0u32;
     let mut elapsed = Duration::ZERO;
+    let mut interrupted = false;
     let row = |film: &Film, checkpoint: u32, elapsed: Duration| {
         let image = film.mean();
         ResultRow {
@@ -123,6 +131,10 @@ pub fn run_strategy(
         }
     };
     loop {
+        if crate::interrupt::requested() {
+            interrupted = true;
+            break;
+        }
         if film.spp > 0 {
             let mean_pass = elapsed.div_f64(film.spp as f64);
             if elapsed + mean_pass > budget {
@@ -148,6 +160,7 @@ pub fn run_strategy(
         variance: film.variance_of_mean(),
         rows,
         mean_sample_variance: film.mean_sample_variance(),
+        interrupted,
     }
 }
 
@@ -238,7 +251,10 @@ pub fn run(
         dibench_version: VERSION,
         rustc: RUSTC,
         commit: COMMIT,
+        interrupted: false,
+        completed: Vec::new(),
     };
+    let mut meta = meta;
     write_json(&run_dir.join("run.json"), &meta)?;
     let mut rows = Vec::new();
     let mut finals = Vec::new();
@@ -262,6 +278,24 @@ pub fn run(
                 bar.set_position(t.as_millis() as u64);
             });
             bar.finish_and_clear();
+            if r.interrupted {
+                // Keep what finished (results.csv is already written), summarise it, record
+                // the interruption; the unfinished strategy leaves no file behind.
+                if !finals.is_empty() {
+                    write_csv(
+                        &run_dir.join("summary.csv"),
+                        &summarize(&finals, opts.time_s),
+                    )?;
+                }
+                meta.interrupted = true;
+                write_json(&run_dir.join("run.json"), &meta)?;
+                return Err(Error::Interrupted(format!(
+                    "compare kept {} finished strategy run(s) in {}; `{}` (run {run}) was discarded",
+                    meta.completed.len(),
+                    run_dir.display(),
+                    s.name()
+                )));
+            }
             if run == 0 {
                 write_exr(&run_dir.join(format!("{}.exr", s.name())), &r.image)?;
                 write_exr(
@@ -277,6 +311,7 @@ pub fn run(
             });
             rows.extend(r.rows);
             write_csv(&run_dir.join("results.csv"), &rows)?;
+            meta.completed.push((s.name().to_string(), run));
         }
     }
     let summary = summarize(&finals, opts.time_s);

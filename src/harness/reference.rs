@@ -128,6 +128,21 @@ pub fn render_progressive(
     };
     let mut next_checkpoint = FIRST_CHECKPOINT_SPP;
     loop {
+        if crate::interrupt::requested() {
+            bar.finish_and_clear();
+            let kept = match checkpoint_out {
+                Some(_) if next_checkpoint > FIRST_CHECKPOINT_SPP => {
+                    format!("; the {} spp checkpoint is stored", next_checkpoint / 2)
+                }
+                _ => "; nothing stored".to_string(),
+            };
+            return Err(Error::Interrupted(format!(
+                "{} reference for `{}` stopped at {} spp{kept}",
+                integrand.name(),
+                scene.scene.name,
+                film.spp
+            )));
+        }
         let done = match time {
             Some(t) => film.spp > 0 && start.elapsed() >= t,
             None => film.spp >= spp,
