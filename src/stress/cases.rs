@@ -305,7 +305,7 @@ fn meshes(out: &mut Vec<StressCase>) {
         MESH_SAMPLERS,
         irradiance(&v, &faces[..2]),
     );
-    case.files = vec![("light.obj".into(), mesh(&v, &faces))];
+    case.files = vec![("light.obj".into(), mesh(&v, &faces).into_bytes())];
     out.push(case);
 
     let h = (2e-8f64).sqrt(); // legs of a right triangle of area 1e-8
@@ -327,7 +327,7 @@ fn meshes(out: &mut Vec<StressCase>) {
         MESH_SAMPLERS,
         irradiance(&v, &faces),
     );
-    case.files = vec![("light.obj".into(), mesh(&v, &faces))];
+    case.files = vec![("light.obj".into(), mesh(&v, &faces).into_bytes())];
     out.push(case);
 }
 
@@ -524,5 +524,108 @@ pub fn all() -> Vec<StressCase> {
     plane_through_origin(&mut out);
     spots(&mut out);
     directional(&mut out);
+    environments(&mut out);
     out
+}
+
+/// A lat/long map as EXR bytes (written through the crate's own writer, then read back).
+fn latlong_exr(width: usize, height: usize, texel: impl Fn(usize, usize) -> f32) -> Vec<u8> {
+    use crate::env::map::{LatLongImage, write_latlong};
+    let img = LatLongImage {
+        width,
+        height,
+        pixels: (0..width * height)
+            .map(|k| glam::Vec3::splat(texel(k % width, k / width)))
+            .collect(),
+        clamped: 0,
+    };
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let path = dir.path().join("map.exr");
+    write_latlong(&path, &img).expect("writing a temporary EXR");
+    std::fs::read(&path).expect("reading back a temporary EXR")
+}
+
+/// Environment maps at the extremes, lighting a Lambertian point facing +Y (the lat/long pole),
+/// with nothing else in the scene. The suite runs the `direct` integrand, i.e. the lat/long
+/// representation, which reproduces a 512×256 input texel for texel (nearest reconstruction,
+/// resampled at the same resolution), so the closed forms are exact sums over texels:
+/// ∫ over a texel of cos θ dω = Δφ (sin²θ₁ − sin²θ₀)/2 in the upper hemisphere.
+fn environments(out: &mut Vec<StressCase>) {
+    const ENV_ALL: &[&str] = &[
+        "uniform",
+        "cosine",
+        "bsdf",
+        MIS[0],
+        "env-latlong-cdf",
+        "env-latlong-hier",
+        "mis-env-latlong-cdf",
+        "mis-env-latlong-hier",
+    ];
+    const ENV_SAMPLERS: &[&str] = &[
+        "env-latlong-cdf",
+        "env-latlong-hier",
+        "mis-env-latlong-cdf",
+        "mis-env-latlong-hier",
+    ];
+    let body = "[environment]\nfile = \"env.exr\"\n".to_string();
+    let with_map = |name: &str, about: String, exr: Vec<u8>, must, e: f64| {
+        let mut case = lambert_case(
+            name.into(),
+            about,
+            body.clone(),
+            DVec3::ZERO,
+            DVec3::Y,
+            must,
+            move |_| e,
+        );
+        case.files = vec![("env.exr".into(), exr)];
+        case
+    };
+    // Sun: one texel 1e6 times the sky (max/median = 1e6), 30° from the zenith.
+    let (w, h) = (512usize, 256usize);
+    let (sky, sun) = (1e-3f64, 1e3f64);
+    let (sx, sy) = (77usize, 42usize);
+    let texel_cos = |y: usize| {
+        let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
+        2.0 * PI / w as f64 * (t1.sin().powi(2) - t0.sin().powi(2)) / 2.0
+    };
+    let e_sun = PI * sky + (sun - sky) * texel_cos(sy);
+    let mut sun_case = with_map(
+        "env-sun-1e6",
+        format!(
+            "512×256 map: sky {sky:e}, one sun texel {sun:e} (max/median 1e6) 30° from the normal"
+        ),
+        latlong_exr(w, h, |x, y| {
+            if (x, y) == (sx, sy) {
+                sun as f32
+            } else {
+                sky as f32
+            }
+        }),
+        ENV_SAMPLERS,
+        e_sun,
+    );
+    // The sun texel is 2e-5 of the cosine-weighted hemisphere: direction samplers see it about
+    // once per 50,000 samples, so their mean is the sky's alone (a rare-event miss the
+    // effective sample size cannot flag, since the sky makes every sample non-zero).
+    sun_case.known_unresolvable = &["uniform", "cosine", "bsdf"];
+    sun_case.why_unresolvable = "direction sampling meets the 2e-5 sun about once per 5e4 samples";
+    out.push(sun_case);
+    // All black: no sampler is built, the baselines must return exactly 0.
+    out.push(with_map(
+        "env-black",
+        "64×32 map, every texel 0".into(),
+        latlong_exr(64, 32, |_, _| 0.0),
+        &[],
+        0.0,
+    ));
+    // 1×1: a constant environment, E = πL, in every representation.
+    let l = 0.7f64;
+    out.push(with_map(
+        "env-1x1",
+        format!("1×1 map of radiance {l} (a constant environment, E = πL)"),
+        latlong_exr(1, 1, |_, _| l as f32),
+        ENV_ALL,
+        PI * l,
+    ));
 }

@@ -95,8 +95,8 @@ pub struct StressCase {
     pub about: String,
     /// The scene file's text.
     pub scene: String,
-    /// Files the scene refers to (name relative to the scene, content).
-    pub files: Vec<(String, String)>,
+    /// Files the scene refers to (name relative to the scene, content: OBJ text, EXR bytes).
+    pub files: Vec<(String, Vec<u8>)>,
     pub point: ViewPoint,
     /// Closed-form reflected radiance at the point, where one is known.
     pub expected: Option<ClosedForm>,
@@ -120,8 +120,8 @@ impl StressCase {
             path: sub.clone(),
             source: e,
         })?;
-        for (name, text) in &self.files {
-            crate::output::write_bytes(&sub.join(name), text.as_bytes())?;
+        for (name, bytes) in &self.files {
+            crate::output::write_bytes(&sub.join(name), bytes)?;
         }
         let path = sub.join("scene.toml");
         crate::output::write_bytes(&path, self.scene.as_bytes())?;
