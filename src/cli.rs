@@ -48,6 +48,14 @@ pub enum Command {
         /// A run directory written by `compare` (holding results.csv).
         run_dir: PathBuf,
     },
+    /// Merge the shards written by `reference --shard i/n` into the scene's reference files.
+    Merge {
+        /// Scene file or name under scenes/ (names the results directory).
+        scene: String,
+        /// Output root holding <scene>/reference/shards/.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
 }
 
 #[derive(Args, Debug)]
@@ -185,6 +193,10 @@ pub struct ReferenceArgs {
     /// Render whole passes for this many seconds instead of a fixed spp.
     #[arg(long, allow_negative_numbers = true)]
     pub time: Option<f64>,
+    /// Render only shard i of n (passes i, i+n, ... of --spp) into <out>/<scene>/reference/
+    /// shards/, for a cluster job array; `dibench merge` then writes the reference.
+    #[arg(long, conflicts_with = "time")]
+    pub shard: Option<String>,
 }
 
 fn load(scene: &str) -> Result<PreparedScene> {
@@ -250,6 +262,13 @@ pub fn run(cli: Cli) -> Result<()> {
         Command::Warp(a) => run_warp(a),
         Command::Crosscheck(a) => run_crosscheck(a),
         Command::Stress(a) => run_stress(a),
+        Command::Merge { scene, out } => {
+            let name = Scene::load(&Scene::resolve(&scene)?)?.name;
+            for p in crate::harness::shard::merge(&out, &name)? {
+                println!("reference: {}", p.display());
+            }
+            Ok(())
+        }
         Command::Plot { run_dir } => {
             for p in crate::plot::plot_run(&run_dir)? {
                 println!("{}", p.display());
@@ -367,6 +386,25 @@ fn run_reference(a: ReferenceArgs) -> Result<()> {
         (_, Some(t)) => reference::Budget::Time(t),
         (n, None) => reference::Budget::Spp(n.unwrap_or(8192)),
     };
+    if let Some(s) = &a.shard {
+        let spec = crate::harness::shard::ShardSpec::parse(s)?;
+        let total = a.spp.unwrap_or(8192);
+        for integrand in strategy::integrands(&scene) {
+            let (film, meta) = pool.install(|| {
+                crate::harness::shard::render(&scene, integrand, total, a.common.seed, spec)
+            })?;
+            let path = crate::harness::shard::save_shard(&a.common.out, &film, &meta)?;
+            println!(
+                "shard {}/{}: {} ({} of {total} spp, {:.1} s, {threads} threads)",
+                spec.index,
+                spec.count,
+                path.display(),
+                meta.spp,
+                meta.wall_time_s
+            );
+        }
+        return Ok(());
+    }
     for integrand in strategy::integrands(&scene) {
         let r = pool.install(|| {
             reference::render_progressive(

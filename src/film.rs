@@ -68,6 +68,28 @@ pub fn accumulate(sum: &mut [f64; 3], m2: &mut [f64; 3], n: u64, x: [f64; 3]) {
 }
 
 impl Film {
+    /// Adds another film's samples of the same pixels (Chan, Golub & LeVeque 1979 on each
+    /// pixel's sum and M2): exact up to roundoff, in any order.
+    pub fn merge(&mut self, other: &Film) {
+        let (na, nb) = (self.spp as f64, other.spp as f64);
+        let n = na + nb;
+        if nb == 0.0 {
+            return;
+        }
+        for k in 0..self.sum.len() {
+            for c in 0..3 {
+                if na > 0.0 {
+                    let d = other.sum[k][c] / nb - self.sum[k][c] / na;
+                    self.m2[k][c] += other.m2[k][c] + d * d * na * nb / n;
+                } else {
+                    self.m2[k][c] = other.m2[k][c];
+                }
+                self.sum[k][c] += other.sum[k][c];
+            }
+        }
+        self.spp += other.spp;
+    }
+
     pub fn new(width: u32, height: u32) -> Self {
         let layout = TileLayout::new(width, height);
         Film {

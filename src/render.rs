@@ -31,16 +31,23 @@ impl<'a> Renderer<'a> {
     /// Adds one sample per pixel to the film; pass `film.spp` numbers the random streams, so
     /// the result is independent of thread count and scheduling.
     pub fn add_pass(&self, film: &mut Film) {
-        let pass = film.spp;
+        self.add_pass_with_stream(film, film.spp);
+    }
+
+    /// Adds one sample per pixel drawn from the random streams of pass `stream`, which need
+    /// not be the film's next pass: shard i of n renders passes i, i + n, … (see
+    /// `harness::shard`), and the merged film equals a sequential render's up to roundoff.
+    pub fn add_pass_with_stream(&self, film: &mut Film, stream: u64) {
+        let count = film.spp;
         let layout = film.layout;
         film.sum
             .par_chunks_mut(16)
             .zip(film.m2.par_chunks_mut(16))
             .enumerate()
             .for_each(|(tile, (sum, m2))| {
-                let radiance = self.render_tile(&layout, tile, pass);
+                let radiance = self.render_tile(&layout, tile, stream);
                 for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
-                    accumulate(s, m, pass, [l.x as f64, l.y as f64, l.z as f64]);
+                    accumulate(s, m, count, [l.x as f64, l.y as f64, l.z as f64]);
                 }
             });
         film.spp += 1;

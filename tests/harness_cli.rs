@@ -350,3 +350,89 @@ fn walk(p: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+/// `reference --shard i/n` on three "machines" plus `dibench merge` gives the reference a
+/// single process renders (same streams per pass; sums merged by Chan's formula, so equal up
+/// to roundoff), and a missing shard is an error naming it.
+#[test]
+fn sharded_reference_merges_to_the_single_process_one() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let (code, _, stderr) = dibench(
+        &["reference", "tiny.toml", "--spp", "30", "--out", "single"],
+        dir.path(),
+    );
+    assert_eq!(code, 0, "{stderr}");
+    for i in 0..3 {
+        let shard = format!("{i}/3");
+        let (code, stdout, stderr) = dibench(
+            &[
+                "reference",
+                "tiny.toml",
+                "--spp",
+                "30",
+                "--shard",
+                &shard,
+                "--threads",
+                "1",
+                "--out",
+                "sharded",
+            ],
+            dir.path(),
+        );
+        assert_eq!(code, 0, "{stderr}");
+        assert!(stdout.contains("10 of 30 spp"), "{stdout}");
+        if i == 1 {
+            // Two of three shards: merging is refused, naming the missing one.
+            let (code, _, stderr) =
+                dibench(&["merge", "tiny.toml", "--out", "sharded"], dir.path());
+            assert_eq!(code, 1);
+            assert!(stderr.contains("shards 2 of 3 missing"), "{stderr}");
+        }
+    }
+    let (code, _, stderr) = dibench(&["merge", "tiny.toml", "--out", "sharded"], dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    for name in ["direct", "ao"] {
+        let read = |root: &str, file: String| {
+            dibench::output::read_exr(&dir.path().join(root).join("tiny/reference").join(file))
+                .unwrap()
+        };
+        for file in [format!("{name}.exr"), format!("{name}.variance.exr")] {
+            let (a, b) = (read("single", file.clone()), read("sharded", file.clone()));
+            assert_eq!(a.pixels.len(), b.pixels.len());
+            let mut worst = 0.0f64;
+            for (p, q) in a.pixels.iter().zip(&b.pixels) {
+                for c in 0..3 {
+                    let scale = p[c].abs().max(q[c].abs()).max(1e-30);
+                    worst = worst.max((p[c] - q[c]).abs() / scale);
+                }
+            }
+            // f32 storage: sums in a different order may round to the neighbouring float.
+            assert!(worst < 1e-5, "{file}: relative difference {worst}");
+        }
+        let meta = std::fs::read_to_string(
+            dir.path()
+                .join(format!("sharded/tiny/reference/{name}.json")),
+        )
+        .unwrap();
+        assert!(
+            meta.contains("\"spp\": 30") || meta.contains("\"spp\":30"),
+            "{meta}"
+        );
+    }
+    let (code, _, stderr) = dibench(
+        &[
+            "reference",
+            "tiny.toml",
+            "--spp",
+            "30",
+            "--shard",
+            "3/3",
+            "--out",
+            "x",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 1);
+    assert!(stderr.contains("--shard must be i/n"), "{stderr}");
+}

@@ -5,6 +5,7 @@ pub mod crosscheck;
 pub mod rays;
 pub mod raysets;
 pub mod reference;
+pub mod shard;
 pub mod summary;
 
 use crate::film::{Film, Image};

@@ -42,7 +42,7 @@ pub fn reference_dir(out: &Path, scene: &str) -> PathBuf {
 /// The reference's random streams are salted so that they never coincide with the streams of
 /// a compared run of the same strategy and seed: an error measured against a correlated
 /// reference would be too small.
-fn reference_stream_seed(seed: u64) -> u64 {
+pub(crate) fn reference_stream_seed(seed: u64) -> u64 {
     mix64(seed) ^ 0x5245_4645_5245_4e43
 }
 

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Render a reference across a cluster as a Slurm job array, then merge it.
+#
+#   sbatch --array=0-15 scripts/reference-slurm.sh cornell 65536
+#   # when all tasks are done (or: sbatch --dependency=afterok:<jobid> --wrap ...):
+#   cargo run --release -- merge cornell --out results
+#
+# Each task renders shard $SLURM_ARRAY_TASK_ID of $SLURM_ARRAY_TASK_COUNT (passes i, i+n, …
+# of SPP) with the same random streams a single process would use, into
+# results/<scene>/reference/shards/; `dibench merge` combines them losslessly. The output
+# root must be on a filesystem every node sees.
+#SBATCH --job-name=dibench-reference
+#SBATCH --cpus-per-task=16
+#SBATCH --time=02:00:00
+#SBATCH --output=dibench-reference-%A_%a.log
+set -euo pipefail
+scene=${1:?usage: sbatch --array=0-N scripts/reference-slurm.sh SCENE SPP [SEED]}
+spp=${2:?total samples per pixel}
+seed=${3:-1}
+: "${SLURM_ARRAY_TASK_ID:?run as a job array (sbatch --array=...)}"
+: "${SLURM_ARRAY_TASK_COUNT:?run as a job array (sbatch --array=...)}"
+cd "${SLURM_SUBMIT_DIR:-$(dirname "$0")/..}"
+# Build once beforehand (cargo build --release) so tasks do not race on target/.
+exec ./target/release/dibench reference "$scene" --spp "$spp" --seed "$seed" \
+  --shard "${SLURM_ARRAY_TASK_ID}/${SLURM_ARRAY_TASK_COUNT}" \
+  ${SLURM_CPUS_PER_TASK:+--threads "$SLURM_CPUS_PER_TASK"} --out results
