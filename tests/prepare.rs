@@ -1,0 +1,134 @@
+//! Preparation builds only what a scene uses: one light per emitter the file declares (no light
+//! structures otherwise), analytic spheres only for declared spheres, environment structures
+//! only with `[environment]`, the AO integrand only with `[ambient_occlusion]`, a light
+//! selection distribution only when there is a light; and every strategy that does not apply
+//! is skipped with a reason. Checked on every built-in scene.
+
+use dibench::lights::Light;
+use dibench::prepare::PreparedScene;
+use dibench::scene::Scene;
+use dibench::strategy::{Integrand, applicable, integrands};
+
+fn scenes() -> Vec<std::path::PathBuf> {
+    let mut v: Vec<_> = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/scenes"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn prepare_builds_only_what_the_scene_declares() {
+    let paths = scenes();
+    assert!(paths.len() >= 10, "{paths:?}");
+    let mut seen_env = (false, false);
+    for path in paths {
+        let scene = Scene::load(&path).unwrap();
+        let name = scene.name.clone();
+        let s = &scene;
+        let emitting = |e: Option<glam::Vec3>| e.is_some_and(|e| e.max_element() > 0.0);
+        let count =
+            |k: fn(&Light) -> bool, p: &PreparedScene| p.lights.iter().filter(|l| k(l)).count();
+        let quads = s.quads.iter().filter(|q| emitting(q.emission)).count();
+        let spheres = s.spheres.iter().filter(|q| emitting(q.emission)).count();
+        let meshes = s.meshes.iter().filter(|q| emitting(q.emission)).count();
+        let (points, spots, dirs) = (
+            s.point_lights.len(),
+            s.spot_lights.len(),
+            s.directional_lights.len(),
+        );
+        let has_env = s.environment.is_some();
+        let has_ao = s.ao_distance.is_some();
+        let n_spheres = s.spheres.len();
+        let p = PreparedScene::new(scene);
+
+        assert_eq!(
+            count(|l| matches!(l, Light::Quad(_)), &p),
+            quads,
+            "{name}: quad lights"
+        );
+        assert_eq!(
+            count(|l| matches!(l, Light::Sphere(_)), &p),
+            spheres,
+            "{name}: sphere lights"
+        );
+        assert_eq!(
+            count(|l| matches!(l, Light::Mesh(_)), &p),
+            meshes,
+            "{name}: mesh lights"
+        );
+        assert_eq!(
+            count(|l| matches!(l, Light::Point(_)), &p),
+            points,
+            "{name}"
+        );
+        assert_eq!(count(|l| matches!(l, Light::Spot(_)), &p), spots, "{name}");
+        assert_eq!(
+            count(|l| matches!(l, Light::Directional(_)), &p),
+            dirs,
+            "{name}"
+        );
+        assert_eq!(
+            count(|l| matches!(l, Light::Environment(_)), &p),
+            has_env as usize,
+            "{name}"
+        );
+        assert_eq!(
+            p.geometry.spheres.len(),
+            n_spheres,
+            "{name}: analytic spheres"
+        );
+        assert_eq!(
+            p.environment.is_some(),
+            has_env,
+            "{name}: environment structures"
+        );
+        assert_eq!(p.env_light.is_some(), has_env, "{name}");
+        assert_eq!(p.light_selection.is_some(), !p.lights.is_empty(), "{name}");
+        if has_env {
+            seen_env.0 = true;
+        } else {
+            seen_env.1 = true;
+        }
+
+        let ints = integrands(&p);
+        assert!(ints.contains(&Integrand::Direct), "{name}");
+        assert_eq!(
+            ints.contains(&Integrand::AmbientOcclusion),
+            has_ao,
+            "{name}: AO"
+        );
+        assert_eq!(
+            ints.len(),
+            1 + has_ao as usize + 3 * has_env as usize,
+            "{name}: {ints:?}"
+        );
+
+        let (run, skipped) = applicable(&p);
+        assert!(!run.is_empty(), "{name}: nothing applies");
+        for k in &skipped {
+            assert!(
+                !k.reason.trim().is_empty(),
+                "{name}: {} skipped without a reason",
+                k.name
+            );
+        }
+        let skipped_env = skipped.iter().any(|k| k.name.starts_with("env-"));
+        assert_eq!(
+            skipped_env, !has_env,
+            "{name}: env strategies skipped iff no environment"
+        );
+        let skipped_ao = skipped.iter().any(|k| k.name.starts_with("ao-"));
+        assert_eq!(
+            skipped_ao, !has_ao,
+            "{name}: AO strategies skipped iff no AO section"
+        );
+    }
+    assert!(
+        seen_env.0 && seen_env.1,
+        "the scenes must include both kinds"
+    );
+}
