@@ -247,9 +247,17 @@ fn bad_environment_input_is_reported() {
     let mut nan = latlong_of_y(8, 4, |_, _| [1.0; 3]);
     nan.pixels[5] = Vec3::new(1.0, f32::NAN, 0.0);
     write_latlong(&dir.path().join("nan.exr"), &nan).unwrap();
+    // A truncated map: the first half of a valid EXR.
+    let good = latlong_of_y(8, 4, |_, _| [1.0; 3]);
+    write_latlong(&dir.path().join("good.exr"), &good).unwrap();
+    let bytes = std::fs::read(dir.path().join("good.exr")).unwrap();
+    std::fs::write(dir.path().join("truncated.exr"), &bytes[..bytes.len() / 2]).unwrap();
+    std::fs::write(dir.path().join("garbage.exr"), b"not an EXR at all").unwrap();
     for (body, field, says) in [
         ("file = \"missing.exr\"", "environment.file", "cannot read"),
         ("file = \"nan.exr\"", "environment.file", "not finite"),
+        ("file = \"truncated.exr\"", "environment.file", "truncated.exr"),
+        ("file = \"garbage.exr\"", "environment.file", "cannot read"),
         (
             "constant = [1.0, -1.0, 0.0]",
             "environment.constant",
