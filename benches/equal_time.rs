@@ -6,7 +6,7 @@
 //! (per-sample variance × cost per sample / budget, plus the reference noise floor) beside the
 //! measured one with its 95 % interval.
 
-use dibench::harness::{compare, reference};
+use dibench::harness::compare;
 use dibench::prepare::PreparedScene;
 use dibench::scene::Scene;
 use dibench::strategy::{applicable, integrands};
@@ -43,21 +43,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let mut images = Vec::new();
         for integrand in integrands(&scene) {
-            let stored = reference::load_matching(&out, &scene, integrand, REFERENCE_SPP)?;
-            let (image, meta) = match stored {
-                Some(r) => r,
-                None => {
-                    let r = reference::render(&scene, integrand, REFERENCE_SPP, 1, threads)?;
-                    reference::save(&out, &r.image, &r.variance, &r.meta)?;
-                    (r.image, r.meta)
-                }
-            };
-            images.push(compare::Reference {
+            images.push(compare::Reference::load_or_render(
+                &out,
+                &scene,
                 integrand,
-                image,
-                spp: meta.spp,
-                noise_floor: meta.noise_floor_rmse,
-            });
+                REFERENCE_SPP,
+                1,
+                threads,
+            )?);
         }
         let opts = compare::CompareOptions {
             time_s,

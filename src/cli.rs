@@ -475,51 +475,14 @@ fn run_compare(a: CompareArgs) -> Result<()> {
             if !run.iter().any(|s| s.integrand() == integrand) {
                 continue;
             }
-            let dir = reference::reference_dir(&a.common.out, &scene.scene.name);
-            let (image, meta) = match reference::load_matching(
+            images.push(compare::Reference::load_or_render(
                 &a.common.out,
                 &scene,
                 integrand,
                 a.reference_spp,
-            )? {
-                Some(r) => {
-                    eprintln!(
-                        "reference ({}): reusing {} spp from {}",
-                        integrand.name(),
-                        r.1.spp,
-                        dir.display()
-                    );
-                    r
-                }
-                None => {
-                    eprintln!(
-                        "reference ({}): rendering {} spp (no matching one stored)",
-                        integrand.name(),
-                        a.reference_spp
-                    );
-                    let r = reference::render(
-                        &scene,
-                        integrand,
-                        a.reference_spp,
-                        a.common.seed,
-                        threads,
-                    )?;
-                    reference::save(&a.common.out, &r.image, &r.variance, &r.meta)?;
-                    eprintln!(
-                        "reference ({}): {:.1} s with `{}`",
-                        integrand.name(),
-                        r.meta.wall_time_s,
-                        r.meta.strategy
-                    );
-                    (r.image, r.meta)
-                }
-            };
-            images.push(compare::Reference {
-                integrand,
-                image,
-                spp: meta.spp,
-                noise_floor: meta.noise_floor_rmse,
-            });
+                a.common.seed,
+                threads,
+            )?);
         }
         let references = compare::References { images };
         let opts = compare::CompareOptions {

@@ -1,21 +1,10 @@
 //! `--backend` and `crosscheck` through the CLI: unknown or not-compiled-in backends are clear
 //! errors listing the available ones; crosscheck writes its CSV.
 
-use std::process::Command;
+mod common;
 
 fn dibench(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dibench"))
-        .args(args)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(
-        !stderr.contains("panicked"),
-        "dibench {args:?} panicked: {stderr}"
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    (out.status.code().unwrap_or(-1), stdout, stderr)
+    common::dibench(args, std::path::Path::new(env!("CARGO_MANIFEST_DIR")))
 }
 
 #[test]

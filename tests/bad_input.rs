@@ -1,8 +1,10 @@
 //! Bad input gets a clear error naming the file and the field, a non-zero exit, and no panic.
 
+mod common;
+use common::dibench;
+
 use dibench::scene::Scene;
 use std::path::Path;
-use std::process::Command;
 
 const GOOD: &str = r#"
 [camera]
@@ -125,20 +127,6 @@ fn invalid_values_name_their_field() {
     }
 }
 
-fn dibench(args: &[&str], cwd: &Path) -> (i32, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dibench"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(
-        !stderr.contains("panicked"),
-        "dibench {args:?} panicked: {stderr}"
-    );
-    (out.status.code().unwrap_or(-1), stderr)
-}
-
 #[test]
 fn cli_reports_user_errors_with_nonzero_exit() {
     let dir = tempfile::tempdir().unwrap();
@@ -167,7 +155,7 @@ fn cli_reports_user_errors_with_nonzero_exit() {
         ),
     ];
     for (args, expect) in cases {
-        let (code, stderr) = dibench(args, dir.path());
+        let (code, _, stderr) = dibench(args, dir.path());
         assert_ne!(code, 0, "dibench {args:?} succeeded");
         assert!(
             stderr.contains(expect),
@@ -188,7 +176,7 @@ fn cli_reports_user_errors_with_nonzero_exit() {
 fn cli_compare_writes_exrs_and_csv() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("ok.toml"), GOOD).unwrap();
-    let (code, stderr) = dibench(
+    let (code, _, stderr) = dibench(
         &[
             "compare",
             "ok.toml",
@@ -231,7 +219,7 @@ fn cli_compare_writes_exrs_and_csv() {
     let stored = dir.path().join("out/ok/reference/direct.exr");
     let bytes = std::fs::read(&stored).unwrap();
     std::fs::write(&stored, &bytes[..bytes.len() / 3]).unwrap();
-    let (code, stderr) = dibench(
+    let (code, _, stderr) = dibench(
         &[
             "compare",
             "ok.toml",
@@ -346,7 +334,7 @@ fn every_bad_input_class_exits_nonzero_naming_file_and_field() {
     ];
     for (class, text, fields) in classes {
         std::fs::write(dir.path().join("bad.toml"), text).unwrap();
-        let (code, stderr) = dibench(&["compare", "bad.toml", "--out", "out"], dir.path());
+        let (code, _, stderr) = dibench(&["compare", "bad.toml", "--out", "out"], dir.path());
         assert_eq!(code, 1, "{class}: exit status {code}, stderr {stderr}");
         assert!(stderr.contains("bad.toml"), "{class}: {stderr}");
         for f in fields {

@@ -256,7 +256,11 @@ fn bad_environment_input_is_reported() {
     for (body, field, says) in [
         ("file = \"missing.exr\"", "environment.file", "cannot read"),
         ("file = \"nan.exr\"", "environment.file", "not finite"),
-        ("file = \"truncated.exr\"", "environment.file", "truncated.exr"),
+        (
+            "file = \"truncated.exr\"",
+            "environment.file",
+            "truncated.exr",
+        ),
         ("file = \"garbage.exr\"", "environment.file", "cannot read"),
         (
             "constant = [1.0, -1.0, 0.0]",

@@ -1,6 +1,9 @@
 //! The rigor harness through the CLI: repeated runs with summary.csv, variance images, run
 //! metadata, reference noise floor and checkpoints, plots, and errors for bad arguments.
 
+mod common;
+use common::dibench;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -35,24 +38,6 @@ material = "m"
 [ambient_occlusion]
 distance = 0.5
 "#;
-
-fn dibench(args: &[&str], cwd: &Path) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_dibench"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert!(
-        !stderr.contains("panicked"),
-        "dibench {args:?} panicked: {stderr}"
-    );
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        stderr,
-    )
-}
 
 fn run_dirs(scene_dir: &Path) -> Vec<PathBuf> {
     std::fs::read_dir(scene_dir)

@@ -185,6 +185,54 @@ pub struct References {
     pub images: Vec<Reference>,
 }
 
+impl Reference {
+    /// The stored reference of `integrand` with at least `spp` samples for this exact scene
+    /// content, else a fresh one rendered (with `seed`) and stored. Says which on stderr.
+    pub fn load_or_render(
+        out: &Path,
+        scene: &PreparedScene,
+        integrand: Integrand,
+        spp: u64,
+        seed: u64,
+        threads: usize,
+    ) -> Result<Reference> {
+        use super::reference;
+        let dir = reference::reference_dir(out, &scene.scene.name);
+        let (image, meta) = match reference::load_matching(out, scene, integrand, spp)? {
+            Some(r) => {
+                eprintln!(
+                    "reference ({}): reusing {} spp from {}",
+                    integrand.name(),
+                    r.1.spp,
+                    dir.display()
+                );
+                r
+            }
+            None => {
+                eprintln!(
+                    "reference ({}): rendering {spp} spp (no matching one stored)",
+                    integrand.name()
+                );
+                let r = reference::render(scene, integrand, spp, seed, threads)?;
+                reference::save(out, &r.image, &r.variance, &r.meta)?;
+                eprintln!(
+                    "reference ({}): {:.1} s with `{}`",
+                    integrand.name(),
+                    r.meta.wall_time_s,
+                    r.meta.strategy
+                );
+                (r.image, r.meta)
+            }
+        };
+        Ok(Reference {
+            integrand,
+            image,
+            spp: meta.spp,
+            noise_floor: meta.noise_floor_rmse,
+        })
+    }
+}
+
 impl References {
     pub fn get(&self, i: Integrand) -> Option<&Reference> {
         self.images.iter().find(|r| r.integrand == i)

@@ -46,6 +46,20 @@ pub(crate) fn reference_stream_seed(seed: u64) -> u64 {
     mix64(seed) ^ 0x5245_4645_5245_4e43
 }
 
+/// The strategy that renders `integrand`'s reference, or an error naming the scene.
+pub(crate) fn strategy_for(
+    scene: &PreparedScene,
+    integrand: Integrand,
+) -> Result<Box<dyn crate::strategy::Strategy>> {
+    reference_strategy(scene, integrand).ok_or_else(|| {
+        Error::Usage(format!(
+            "scene `{}`: no strategy can render a {} reference",
+            scene.scene.name,
+            integrand.name()
+        ))
+    })
+}
+
 /// How long a reference renders.
 #[derive(Clone, Copy, Debug)]
 pub enum Budget {
@@ -95,13 +109,7 @@ pub fn render_progressive(
         }
         Budget::Time(t) => (u64::MAX, Some(Duration::from_secs_f64(t))),
     };
-    let strategy = reference_strategy(scene, integrand).ok_or_else(|| {
-        Error::Usage(format!(
-            "scene `{}`: no strategy can render a {} reference",
-            scene.scene.name,
-            integrand.name()
-        ))
-    })?;
+    let strategy = strategy_for(scene, integrand)?;
     let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
     let bar = progress_bar(
         if time.is_some() { 0 } else { spp },

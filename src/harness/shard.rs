@@ -5,14 +5,14 @@
 //! files, equal to a single-process render up to roundoff. `scripts/reference-slurm.sh` runs
 //! the shards as a Slurm job array.
 
-use super::reference::{ReferenceMeta, reference_dir, reference_stream_seed, save};
+use super::reference::{ReferenceMeta, reference_dir, reference_stream_seed, save, strategy_for};
 use super::{COMMIT, VERSION};
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::output::{write_bytes, write_json};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
-use crate::strategy::{Integrand, reference_strategy};
+use crate::strategy::Integrand;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -79,13 +79,7 @@ pub fn render(
     if total_spp == 0 {
         return Err(Error::Usage("--spp must be at least 1".into()));
     }
-    let strategy = reference_strategy(scene, integrand).ok_or_else(|| {
-        Error::Usage(format!(
-            "scene `{}`: no strategy can render a {} reference",
-            scene.scene.name,
-            integrand.name()
-        ))
-    })?;
+    let strategy = strategy_for(scene, integrand)?;
     let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let start = Instant::now();
