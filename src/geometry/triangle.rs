@@ -161,13 +161,13 @@ impl Triangle {
         // (pbrt-v4 §6.8.7, both sides scaled by |det|) is not provably positive; rather than
         // drop it (pbrt does; that loses real hits up to ~1e-5 of the triangle's extent away,
         // e.g. a light 1e-6 below a receiver), redo t in f64, where the bound is 2⁻²⁹ as wide.
-        let bound = conservative_t_bound(
-            [ax, bx, cx],
-            [ay, by, cy],
-            [wr.sz * a[kz], wr.sz * b[kz], wr.sz * c[kz]],
-            [u, v, w],
-        );
-        if ts <= bound {
+        // Only a triangle that reaches back to the origin's side can be hit at a t that is
+        // rounding: when every vertex is strictly ahead along the ray's dominant axis (the
+        // signs of vᵢ − o and of the shear are exact in floating point), every hit has t > 0
+        // and the bound is skipped.
+        let z = [wr.sz * a[kz], wr.sz * b[kz], wr.sz * c[kz]];
+        let ahead = z[0] > 0.0 && z[1] > 0.0 && z[2] > 0.0;
+        if !ahead && ts <= conservative_t_bound([ax, bx, cx], [ay, by, cy], z, [u, v, w]) {
             t = self.provable_t_f64(ray, wr)?;
             if t >= ray.tmax {
                 return None;

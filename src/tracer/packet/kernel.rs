@@ -130,8 +130,11 @@ fn triangle<L: Lanes>(
         let tm = L::load(tmax);
         hit &= L::lt(zero, tss) & L::lt(tss, L::mul(tm, L::abs(det)));
         // t within the test's error bound (pbrt-v4 §6.8.7): see `conservative_t_bound`, same
-        // expression, same order as the scalar test.
-        if hit != 0 {
+        // expression, same order as the scalar test, and skipped, as there, for triangles
+        // wholly ahead of the origin along the dominant axis.
+        let ahead = L::lt(zero, az) & L::lt(zero, bz) & L::lt(zero, cz);
+        let check = hit & !ahead;
+        if check != 0 {
             let amax = |p: L::V, q: L::V, r: L::V| L::max(L::max(L::abs(p), L::abs(q)), L::abs(r));
             let (max_xt, max_yt) = (amax(ax, bx, cx), amax(ay, by, cy));
             let (max_zt, max_e) = (amax(az, bz, cz), amax(u, v, w));
@@ -157,7 +160,7 @@ fn triangle<L: Lanes>(
                 ),
             );
             // Lanes inside the bound take the scalar path, which settles them in f64.
-            let ambiguous = hit & !L::lt(bound, tss);
+            let ambiguous = check & !L::lt(bound, tss);
             hit &= !ambiguous;
             unsure |= ambiguous;
         }
