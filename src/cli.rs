@@ -314,13 +314,13 @@ fn run_stress(a: StressArgs) -> Result<()> {
         a.seed
     );
     println!(
-        "{:<24} {:<17} {:>5} {:>9} {:>12} {:>12} {:>7} {:>10}  status",
+        "{:<24} {:<20} {:>5} {:>9} {:>12} {:>12} {:>7} {:>10}  status",
         "case", "strategy", "bad", "ess", "mean", "expected", "z", "rel.var"
     );
     let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("-".to_string(), f);
     for r in &rows {
         println!(
-            "{:<24} {:<17} {:>5} {:>9.0} {:>12.5e} {:>12} {:>7} {:>10}  {:?}{}{}",
+            "{:<24} {:<20} {:>5} {:>9.0} {:>12.5e} {:>12} {:>7} {:>10}  {:?}{}{}",
             r.case,
             r.strategy,
             r.nan + r.inf + r.negative,
@@ -509,7 +509,7 @@ fn run_compare(a: CompareArgs) -> Result<()> {
         );
         let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
         println!(
-            "{:<18} {:>9} {:>4} {:>8} {:>8} {:>10} {:>9} {:>10} {:>9} {:>10} {:>10} {:>6}",
+            "{:<20} {:>9} {:>4} {:>8} {:>8} {:>10} {:>9} {:>10} {:>9} {:>10} {:>10} {:>6}",
             "strategy",
             "integrand",
             "runs",
@@ -525,7 +525,7 @@ fn run_compare(a: CompareArgs) -> Result<()> {
         );
         for r in &report.summary {
             println!(
-                "{:<18} {:>9} {:>4} {:>8.0} {:>8.3} {:>10.3e} {:>9} {:>10.3e} {:>9} {:>10.3e} {:>10.3e} {:>6}",
+                "{:<20} {:>9} {:>4} {:>8.0} {:>8.3} {:>10.3e} {:>9} {:>10.3e} {:>9} {:>10.3e} {:>10.3e} {:>6}",
                 r.strategy,
                 r.integrand,
                 r.runs,
@@ -588,7 +588,7 @@ fn run_strategies(scene: Option<String>) -> Result<()> {
                 Err(why) => format!("  [skipped: {why}]"),
             },
         };
-        println!("{:<18} {}{status}", s.name(), s.describe());
+        println!("{:<20} {}{status}", s.name(), s.describe());
     }
     Ok(())
 }

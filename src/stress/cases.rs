@@ -78,6 +78,7 @@ fn lambert_case(
         must_resolve,
         known_unresolvable: &[],
         why_unresolvable: "",
+        every_env_representation: false,
     }
 }
 
@@ -374,6 +375,7 @@ fn phong(out: &mut Vec<StressCase>) {
             // its peak (bsdf sampling cannot show it: its f/pdf cancels by construction).
             known_unresolvable: if exponent > 1e5 { &[MIS[0]] } else { &[] },
             why_unresolvable: "f32 precision floor of the n = 1e6 lobe pdf (~6e-6 relative)",
+            every_env_representation: false,
         });
     }
 }
@@ -546,9 +548,11 @@ fn latlong_exr(width: usize, height: usize, texel: impl Fn(usize, usize) -> f32)
 }
 
 /// Environment maps at the extremes, lighting a Lambertian point facing +Y (the lat/long pole),
-/// with nothing else in the scene. The suite runs the `direct` integrand, i.e. the lat/long
-/// representation, which reproduces a 512×256 input texel for texel (nearest reconstruction,
-/// resampled at the same resolution), so the closed forms are exact sums over texels:
+/// with nothing else in the scene. The black and 1×1 maps are the same function in every
+/// representation, so all 16 environment strategies run on them; for the sun map the suite
+/// runs the `direct` integrand, i.e. the lat/long representation, which reproduces a 512×256
+/// input texel for texel (nearest reconstruction, resampled at the same resolution), so the
+/// closed form is an exact sum over texels:
 /// ∫ over a texel of cos θ dω = Δφ (sin²θ₁ − sin²θ₀)/2 in the upper hemisphere.
 fn environments(out: &mut Vec<StressCase>) {
     const ENV_ALL: &[&str] = &[
@@ -560,6 +564,18 @@ fn environments(out: &mut Vec<StressCase>) {
         "env-latlong-hier",
         "mis-env-latlong-cdf",
         "mis-env-latlong-hier",
+        "env-cube-cdf",
+        "env-cube-hier",
+        "env-octa-cdf",
+        "env-octa-hier",
+        "env-healpix-cdf",
+        "env-healpix-hier",
+        "mis-env-cube-cdf",
+        "mis-env-cube-hier",
+        "mis-env-octa-cdf",
+        "mis-env-octa-hier",
+        "mis-env-healpix-cdf",
+        "mis-env-healpix-hier",
     ];
     const ENV_SAMPLERS: &[&str] = &[
         "env-latlong-cdf",
@@ -612,20 +628,26 @@ fn environments(out: &mut Vec<StressCase>) {
     sun_case.why_unresolvable = "direction sampling meets the 2e-5 sun about once per 5e4 samples";
     out.push(sun_case);
     // All black: no sampler is built, the baselines must return exactly 0.
-    out.push(with_map(
+    let mut black = with_map(
         "env-black",
         "64×32 map, every texel 0".into(),
         latlong_exr(64, 32, |_, _| 0.0),
         &[],
         0.0,
-    ));
+    );
+    black.every_env_representation = true;
+    out.push(black);
     // 1×1: a constant environment, E = πL, in every representation.
     let l = 0.7f64;
-    out.push(with_map(
+    let mut constant = with_map(
         "env-1x1",
-        format!("1×1 map of radiance {l} (a constant environment, E = πL)"),
+        format!(
+            "1×1 map of radiance {l} (a constant environment, E = πL, in every representation)"
+        ),
         latlong_exr(1, 1, |_, _| l as f32),
         ENV_ALL,
         PI * l,
-    ));
+    );
+    constant.every_env_representation = true;
+    out.push(constant);
 }

@@ -109,6 +109,9 @@ pub struct StressCase {
     /// (Their NaN/Inf/negative counts still fail.)
     pub known_unresolvable: &'static [&'static str],
     pub why_unresolvable: &'static str,
+    /// The closed form holds in every environment representation (a constant or black map),
+    /// so the cube, octahedral and HEALPix strategies run too, not only lat/long.
+    pub every_env_representation: bool,
 }
 
 impl StressCase {
@@ -338,7 +341,11 @@ pub fn run(cases: &[StressCase], samples: u64, seed: u64) -> Result<Vec<StressRo
         let (run, skipped) = applicable(&scene);
         let run: Vec<_> = run
             .into_iter()
-            .filter(|s| s.integrand() == Integrand::Direct)
+            .filter(|s| match s.integrand() {
+                Integrand::Direct => true,
+                Integrand::DirectEnv(_) => case.every_env_representation,
+                _ => false,
+            })
             .collect();
         if run.is_empty() {
             empty.push((k, skipped));
