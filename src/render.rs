@@ -165,9 +165,6 @@ pub fn escape_contribution(
     sp: &ShadingPoint,
     probe: &crate::strategy::EmissionProbe,
 ) -> Vec3 {
-    if scene.environment.is_none() {
-        return Vec3::ZERO;
-    }
     let le = scene.env_radiance(strategy.env_repr(), probe.ray.dir);
     if le == Vec3::ZERO {
         return Vec3::ZERO;

@@ -68,14 +68,56 @@ impl WatertightRay {
 /// expression in the same order, so both paths accept the same hits.
 #[inline(always)]
 pub fn conservative_t_bound(x: [f32; 3], y: [f32; 3], z: [f32; 3], e: [f32; 3]) -> f32 {
-    use crate::math::gamma;
-    let amax = |a: [f32; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());
+    t_bound(x, y, z, e)
+}
+
+/// The float types the bound is evaluated in: f32 beside the SIMD kernel, f64 for the
+/// recomputation of a t inside the f32 bound.
+trait BoundFloat:
+    Copy + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self> + From<u8>
+{
+    fn abs(self) -> Self;
+    fn max(self, o: Self) -> Self;
+    /// γₙ = nε/(1 − nε) for this type's unit roundoff ε (Higham §3.1).
+    fn gamma(n: u8) -> Self;
+}
+
+impl BoundFloat for f32 {
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    fn max(self, o: Self) -> Self {
+        f32::max(self, o)
+    }
+    fn gamma(n: u8) -> Self {
+        crate::math::gamma(n as u32)
+    }
+}
+
+impl BoundFloat for f64 {
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    fn max(self, o: Self) -> Self {
+        f64::max(self, o)
+    }
+    fn gamma(n: u8) -> Self {
+        let e = n as f64 * (0.5 * f64::EPSILON);
+        e / (1.0 - e)
+    }
+}
+
+/// pbrt-v4 §6.8.7 `deltaT`·|det| in type `F`, evaluated in the order the SIMD kernel uses.
+#[inline(always)]
+fn t_bound<F: BoundFloat>(x: [F; 3], y: [F; 3], z: [F; 3], e: [F; 3]) -> F {
+    let g = F::gamma;
+    let amax = |a: [F; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());
     let (max_xt, max_yt, max_zt, max_e) = (amax(x), amax(y), amax(z), amax(e));
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
-    let delta_z = gamma(3) * max_zt;
-    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-    3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
+    let delta_x = g(5) * (max_xt + max_zt);
+    let delta_y = g(5) * (max_yt + max_zt);
+    let delta_z = g(3) * max_zt;
+    let delta_e = F::from(2) * (g(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    F::from(3) * (g(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e)
 }
 
 /// Hit distance and barycentrics (b1, b2) of the hit point p = (1-b1-b2) v0 + b1 v1 + b2 v2.
@@ -203,19 +245,7 @@ impl Triangle {
             return None;
         }
         let ts = (u * az + v * bz + w * cz) * det.signum();
-        let g = |n: f64| {
-            let e = n * 0.5 * f64::EPSILON;
-            e / (1.0 - e)
-        };
-        let amax = |p: f64, q: f64, r: f64| p.abs().max(q.abs()).max(r.abs());
-        let (max_xt, max_yt, max_zt) = (amax(ax, bx, cx), amax(ay, by, cy), amax(az, bz, cz));
-        let max_e = amax(u, v, w);
-        let delta_x = g(5.0) * (max_xt + max_zt);
-        let delta_y = g(5.0) * (max_yt + max_zt);
-        let delta_z = g(3.0) * max_zt;
-        let delta_e = 2.0 * (g(2.0) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
-        let bound = 3.0 * (g(3.0) * max_e * max_zt + delta_e * max_zt + delta_z * max_e);
-        if ts <= bound {
+        if ts <= t_bound([ax, bx, cx], [ay, by, cy], [az, bz, cz], [u, v, w]) {
             return None;
         }
         let t = (ts / det.abs()) as f32;

@@ -28,9 +28,10 @@ impl RaySet {
 pub const SET_NAMES: [&str; 3] = ["primary", "shadow_area", "incoherent"];
 
 /// Camera rays (one per pixel, jittered, tile by tile), then from each surface the primary rays
-/// hit (found with the scene's own tracer): a shadow ray to a light sample in front of the surface (finite tmax) and a
-/// uniformly random direction into the hemisphere facing the camera (infinite tmax). Shadow
-/// rays need a light with positive power; the set is empty otherwise.
+/// hit (found with the scene's own tracer): a shadow ray to a light sample in front of the
+/// surface (finite tmax) and a uniformly random direction into the hemisphere facing the
+/// camera (infinite tmax). Shadow rays need a light with positive power; the set is empty
+/// otherwise.
 pub fn generate(scene: &PreparedScene, seed: u64) -> Vec<RaySet> {
     let camera = &scene.scene.camera;
     let (w, h) = (scene.scene.width, scene.scene.height);
