@@ -24,7 +24,7 @@ fn sample_pass(c: &mut Criterion) {
             .warm_up_time(Duration::from_millis(300))
             .measurement_time(Duration::from_secs(2));
         for s in &strategies {
-            let renderer = Renderer::new(&scene, s.as_ref(), 1);
+            let mut renderer = Renderer::new(&scene, s.as_ref(), 1).unwrap();
             let mut film = Film::new(scene.scene.width, scene.scene.height);
             group.bench_function(s.name(), |b| b.iter(|| renderer.add_pass(&mut film)));
         }

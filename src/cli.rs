@@ -463,7 +463,7 @@ fn run_compare(a: CompareArgs) -> Result<()> {
                 )));
             }
         }
-        run.retain(|s| wanted.iter().any(|w| w == s.name()));
+        run.retain(|s| wanted.contains(&s.name()));
         skipped.retain(|k| wanted.contains(&k.name));
     }
     for k in &skipped {
@@ -583,7 +583,7 @@ fn run_strategies(scene: Option<String>) -> Result<()> {
     for s in strategy::registry() {
         let status = match &prepared {
             None => String::new(),
-            Some(p) => match s.applies(p) {
+            Some(p) => match strategy::applies(s.as_ref(), p) {
                 Ok(()) => "  [applies]".into(),
                 Err(why) => format!("  [skipped: {why}]"),
             },
@@ -614,7 +614,7 @@ fn run_warp(a: WarpArgs) -> Result<()> {
     }
     let name = a.name.unwrap_or_default();
     let entry = by_name(&name).ok_or_else(|| {
-        let known: Vec<_> = registry().iter().map(|e| e.name).collect();
+        let known: Vec<_> = registry().iter().map(|e| e.name.clone()).collect();
         Error::Usage(format!(
             "unknown sampler `{name}` (known: {})",
             known.join(", ")

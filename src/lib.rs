@@ -19,6 +19,7 @@ pub mod math;
 pub mod metrics;
 pub mod output;
 pub mod plot;
+pub mod plugin;
 pub mod prepare;
 pub mod render;
 pub mod sampling;

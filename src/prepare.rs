@@ -1,5 +1,7 @@
-//! Scene → what the renderer needs, and only that: the triangles and spheres the tracer
-//! intersects, per-primitive materials, and light structures only for the lights present.
+//! Scene → what the renderer needs, and only that, in two parts: the [`World`] (the triangles
+//! and spheres the tracer intersects, per-primitive materials and emitters) and the
+//! [`LightSet`] (light structures only for the lights present, selectors built on demand).
+//! A strategy sees both through a [`SceneView`], never the tracer.
 
 use crate::bsdf::Bsdf;
 use crate::env::{Environment, Repr};
@@ -13,35 +15,32 @@ use crate::lights::point::PointLight;
 use crate::lights::quad::QuadLight;
 use crate::lights::sphere::SphereLight;
 use crate::lights::spot::SpotLight;
-use crate::lights::{Light, LightMethods, LightSample, QuadMethod};
-use crate::sampling::discrete::DiscreteDistribution;
+use crate::lights::{EmitterRef, Light, LightSet};
 use crate::scene::Scene;
+use crate::strategy::Integrand;
 use crate::tracer::bvh::ObvhsTracer;
 use crate::tracer::{Geometry, Tracer};
 use glam::Vec3;
 use std::sync::Arc;
 
-/// Which light (and, for a mesh light, which of its triangles) a primitive emits as.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct EmitterRef {
-    pub light: u32,
-    pub local: u32,
+/// What rays hit and what the hit points are made of.
+#[derive(Debug)]
+pub struct World {
+    pub geometry: Arc<Geometry>,
+    pub prim_material: Vec<u32>,
+    pub prim_emitter: Vec<Option<EmitterRef>>,
+    pub materials: Vec<Bsdf>,
+    /// Occlusion distance of the ambient-occlusion integrand, when the scene asks for it.
+    pub ao_distance: Option<f32>,
+    /// Radius of a bounding sphere of the geometry and the camera.
+    pub radius: f32,
 }
 
 pub struct PreparedScene {
     pub scene: Scene,
-    pub geometry: Arc<Geometry>,
+    pub world: World,
+    pub lights: LightSet,
     pub tracer: Box<dyn Tracer>,
-    pub prim_material: Vec<u32>,
-    pub prim_emitter: Vec<Option<EmitterRef>>,
-    pub bsdfs: Vec<Bsdf>,
-    pub lights: Vec<Light>,
-    /// Power-proportional light selection; None when no light has positive power.
-    pub light_selection: Option<DiscreteDistribution>,
-    /// The environment in every representation, built only when the scene has one.
-    pub environment: Option<Arc<Environment>>,
-    /// Index of the environment in `lights`.
-    pub env_light: Option<usize>,
 }
 
 /// A surface point hit by a ray.
@@ -56,161 +55,37 @@ pub struct SurfaceHit {
     pub emitter: Option<EmitterRef>,
 }
 
-impl PreparedScene {
-    pub fn new(scene: Scene) -> Self {
-        Self::with_tracer(scene, |g| Box::new(ObvhsTracer::build(g)))
+/// The scene as one integrand sees it: the world, the lights, and the representation the
+/// environment is looked up in (each integrand has its own: resampling changes the radiance
+/// function slightly, so each has its own reference). What a strategy is given.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneView<'a> {
+    pub world: &'a World,
+    pub lights: &'a LightSet,
+    pub env: Repr,
+}
+
+impl SceneView<'_> {
+    /// Radiance the environment sends along -`dir` (zero without one).
+    pub fn env_radiance(&self, dir: Vec3) -> Vec3 {
+        self.lights.env_radiance(self.env, dir)
     }
 
-    /// Prepares with a tracer of the caller's choice (a backend built over the same geometry).
-    pub fn with_tracer(
-        scene: Scene,
-        make_tracer: impl FnOnce(Arc<Geometry>) -> Box<dyn Tracer>,
-    ) -> Self {
-        let mut g = Geometry::default();
-        let mut prim_material = Vec::new();
-        let mut prim_emitter = Vec::new();
-        let mut lights = Vec::new();
-
-        for mesh in &scene.meshes {
-            let tris: Vec<Triangle> = mesh
-                .triangles
-                .iter()
-                .map(|t| {
-                    Triangle::new(
-                        mesh.positions[t[0] as usize],
-                        mesh.positions[t[1] as usize],
-                        mesh.positions[t[2] as usize],
-                    )
-                })
-                .collect();
-            let light = mesh
-                .emission
-                .and_then(|l| MeshLight::new(tris.clone(), l))
-                .map(|m| {
-                    lights.push(Light::Mesh(m));
-                    lights.len() as u32 - 1
-                });
-            for (k, t) in tris.into_iter().enumerate() {
-                g.triangles.push(t);
-                prim_material.push(mesh.material);
-                prim_emitter.push(light.map(|light| EmitterRef {
-                    light,
-                    local: k as u32,
-                }));
-            }
-        }
-        for q in &scene.quads {
-            let light = q.emission.map(|l| {
-                lights.push(Light::Quad(QuadLight::new(q.corner, q.edge_u, q.edge_v, l)));
-                lights.len() as u32 - 1
-            });
-            let (c, u, v) = (q.corner, q.edge_u, q.edge_v);
-            // Both triangles keep the winding of edge_u × edge_v.
-            for t in [
-                Triangle::new(c, c + u, c + u + v),
-                Triangle::new(c, c + u + v, c + v),
-            ] {
-                g.triangles.push(t);
-                prim_material.push(q.material);
-                prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
-            }
-        }
-        for s in &scene.spheres {
-            let light = s.emission.map(|l| {
-                lights.push(Light::Sphere(SphereLight {
-                    center: s.center,
-                    radius: s.radius,
-                    radiance: l,
-                }));
-                lights.len() as u32 - 1
-            });
-            g.spheres.push(Sphere {
-                center: s.center,
-                radius: s.radius,
-            });
-            prim_material.push(s.material);
-            prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
-        }
-        for p in &scene.point_lights {
-            lights.push(Light::Point(PointLight {
-                position: p.position,
-                intensity: p.intensity,
-            }));
-        }
-        for s in &scene.spot_lights {
-            lights.push(Light::Spot(SpotLight {
-                position: s.position,
-                axis: s.direction,
-                intensity: s.intensity,
-                cos_cone: s.cos_cone,
-                cos_falloff_start: s.cos_falloff_start,
-            }));
-        }
-        let scene_radius = bounding_radius(&g, &scene.camera);
-        if !scene.directional_lights.is_empty() {
-            for d in &scene.directional_lights {
-                lights.push(Light::Directional(DirectionalLight {
-                    to_light: -d.direction,
-                    irradiance: d.irradiance,
-                    scene_radius,
-                }));
-            }
-        }
-        let environment = scene
-            .environment
-            .as_ref()
-            .map(|spec| Arc::new(Environment::build(&|w| spec.radiance(w))));
-        let env_light = environment.as_ref().map(|env| {
-            lights.push(Light::Environment(EnvironmentLight {
-                env: env.clone(),
-                scene_radius,
-            }));
-            lights.len() - 1
-        });
-        let bsdfs = scene
-            .materials
-            .iter()
-            .map(|m| Bsdf::new(m.albedo, m.specular, m.exponent))
-            .collect();
-
-        let light_selection = if lights.is_empty() {
-            None
-        } else {
-            DiscreteDistribution::new(&lights.iter().map(Light::power).collect::<Vec<_>>())
-        };
-        let geometry = Arc::new(g);
-        let tracer = make_tracer(geometry.clone());
-        PreparedScene {
-            scene,
-            geometry,
-            tracer,
-            prim_material,
-            prim_emitter,
-            bsdfs,
-            lights,
-            light_selection,
-            environment,
-            env_light,
-        }
-    }
-
-    /// Radiance the environment sends along -`dir` in representation `repr` (zero without one).
-    pub fn env_radiance(&self, repr: Repr, dir: Vec3) -> Vec3 {
-        match &self.environment {
-            Some(env) => env.radiance(repr, dir),
+    /// Radiance an emitter primitive sends back along a ray that hit it.
+    pub fn emitted(&self, surface: &SurfaceHit, ray_dir: Vec3) -> Vec3 {
+        match surface.emitter {
+            Some(e) => self.lights.emitted(e, surface.ng, -ray_dir),
             None => Vec3::ZERO,
         }
     }
 
-    /// The pdf with which [`Self::sample_light`] produces direction `wi` towards the
-    /// environment (selection probability included); 0 without one.
-    pub fn env_light_pdf(&self, wi: Vec3, methods: &LightMethods) -> f32 {
-        match (self.env_light, &self.light_selection, &self.environment) {
-            (Some(i), Some(sel), Some(env)) => sel.pmf(i) * env.pdf(methods.env, wi),
-            _ => 0.0,
-        }
+    /// Some primitive emits (a direction can hit a light).
+    pub fn has_emitting_surface(&self) -> bool {
+        self.world.prim_emitter.iter().any(Option::is_some)
     }
+}
 
+impl World {
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
         let (p, p_error, ng) = match self.geometry.sphere_index(hit.prim) {
             None => {
@@ -233,56 +108,168 @@ impl PreparedScene {
             emitter: self.prim_emitter[hit.prim as usize],
         }
     }
+}
 
-    /// Radiance an emitter primitive sends back along a ray that hit it.
-    pub fn emitted(&self, surface: &SurfaceHit, ray_dir: Vec3) -> Vec3 {
-        match surface.emitter {
-            Some(e) => self.lights[e.light as usize].emitted(surface.ng, -ray_dir),
-            None => Vec3::ZERO,
+impl PreparedScene {
+    pub fn new(scene: Scene) -> Self {
+        Self::with_tracer(scene, |g| Box::new(ObvhsTracer::build(g)))
+    }
+
+    /// Prepares with a tracer of the caller's choice (a backend built over the same geometry).
+    pub fn with_tracer(
+        scene: Scene,
+        make_tracer: impl FnOnce(Arc<Geometry>) -> Box<dyn Tracer>,
+    ) -> Self {
+        let mut g = Geometry::default();
+        let mut prim_material = Vec::new();
+        let mut prim_emitter = Vec::new();
+        let mut lights: Vec<Box<dyn Light>> = Vec::new();
+        let add = |lights: &mut Vec<Box<dyn Light>>, l: Box<dyn Light>| {
+            lights.push(l);
+            lights.len() as u32 - 1
+        };
+
+        for mesh in &scene.meshes {
+            let tris: Vec<Triangle> = mesh
+                .triangles
+                .iter()
+                .map(|t| {
+                    Triangle::new(
+                        mesh.positions[t[0] as usize],
+                        mesh.positions[t[1] as usize],
+                        mesh.positions[t[2] as usize],
+                    )
+                })
+                .collect();
+            let light = mesh
+                .emission
+                .and_then(|l| MeshLight::new(tris.clone(), l))
+                .map(|m| add(&mut lights, Box::new(m)));
+            for (k, t) in tris.into_iter().enumerate() {
+                g.triangles.push(t);
+                prim_material.push(mesh.material);
+                prim_emitter.push(light.map(|light| EmitterRef {
+                    light,
+                    local: k as u32,
+                }));
+            }
+        }
+        for q in &scene.quads {
+            let light = q.emission.map(|l| {
+                add(
+                    &mut lights,
+                    Box::new(QuadLight::new(q.corner, q.edge_u, q.edge_v, l)),
+                )
+            });
+            let (c, u, v) = (q.corner, q.edge_u, q.edge_v);
+            // Both triangles keep the winding of edge_u × edge_v.
+            for t in [
+                Triangle::new(c, c + u, c + u + v),
+                Triangle::new(c, c + u + v, c + v),
+            ] {
+                g.triangles.push(t);
+                prim_material.push(q.material);
+                prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
+            }
+        }
+        for s in &scene.spheres {
+            let light = s.emission.map(|l| {
+                add(
+                    &mut lights,
+                    Box::new(SphereLight {
+                        center: s.center,
+                        radius: s.radius,
+                        radiance: l,
+                    }),
+                )
+            });
+            g.spheres.push(Sphere {
+                center: s.center,
+                radius: s.radius,
+            });
+            prim_material.push(s.material);
+            prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
+        }
+        for p in &scene.point_lights {
+            lights.push(Box::new(PointLight {
+                position: p.position,
+                intensity: p.intensity,
+            }));
+        }
+        for s in &scene.spot_lights {
+            lights.push(Box::new(SpotLight {
+                position: s.position,
+                axis: s.direction,
+                intensity: s.intensity,
+                cos_cone: s.cos_cone,
+                cos_falloff_start: s.cos_falloff_start,
+            }));
+        }
+        let radius = bounding_radius(&g, &scene.camera);
+        for d in &scene.directional_lights {
+            lights.push(Box::new(DirectionalLight {
+                to_light: -d.direction,
+                irradiance: d.irradiance,
+                scene_radius: radius,
+            }));
+        }
+        let environment = scene.environment.as_ref().map(|spec| {
+            let env = Arc::new(Environment::build(&|w| spec.radiance(w)));
+            lights.push(Box::new(EnvironmentLight {
+                env: env.clone(),
+                scene_radius: radius,
+            }));
+            (lights.len() - 1, env)
+        });
+        let materials = scene
+            .materials
+            .iter()
+            .map(|m| Bsdf::blend(m.albedo, m.specular, m.exponent))
+            .collect();
+        let geometry = Arc::new(g);
+        let tracer = make_tracer(geometry.clone());
+        PreparedScene {
+            world: World {
+                geometry,
+                prim_material,
+                prim_emitter,
+                materials,
+                ao_distance: scene.ao_distance,
+                radius,
+            },
+            lights: LightSet::new(lights, environment),
+            tracer,
+            scene,
         }
     }
 
-    /// Picks a light by power and samples it by `methods`; the returned pdf includes the
-    /// selection probability.
+    /// The scene as `integrand` sees it.
+    pub fn view(&self, integrand: Integrand) -> SceneView<'_> {
+        SceneView {
+            world: &self.world,
+            lights: &self.lights,
+            env: integrand.env_repr(),
+        }
+    }
+
+    pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfaceHit {
+        self.world.surface(ray, hit)
+    }
+
+    /// A light sample from `p` with the default selector and `methods` (for ray-set
+    /// generation, which needs realistic shadow rays, not a strategy).
     pub fn sample_light(
         &self,
         p: Vec3,
         u_select: f32,
         u: [f32; 3],
-        methods: &LightMethods,
-    ) -> Option<(usize, LightSample)> {
-        let sel = self.light_selection.as_ref()?;
-        let i = sel.sample(u_select);
-        let mut s = self.lights[i].sample(p, u, methods)?;
-        s.pdf *= sel.pmf(i);
-        Some((i, s))
-    }
-
-    /// The pdf with which [`Self::sample_light`] produces the direction from p to point q of
-    /// the emitter `e` (selection probability included).
-    pub fn light_pdf(&self, p: Vec3, q: Vec3, e: EmitterRef, methods: &LightMethods) -> f32 {
-        let Some(sel) = self.light_selection.as_ref() else {
-            return 0.0;
-        };
-        sel.pmf(e.light as usize) * self.lights[e.light as usize].pdf(p, q, e.local, methods)
-    }
-
-    /// True if the scene has a light `kind` accepts.
-    pub fn has_light(&self, kind: impl Fn(&Light) -> bool) -> bool {
-        self.lights.iter().any(kind)
-    }
-
-    /// `methods` with what this scene cannot use replaced: spherical-rectangle sampling needs
-    /// rectangles, not general parallelograms.
-    pub fn usable_methods(&self, mut methods: LightMethods) -> LightMethods {
-        if self
+        methods: &crate::lights::LightMethods,
+    ) -> Option<(usize, crate::lights::LightSample)> {
+        let sel = self
             .lights
-            .iter()
-            .any(|l| matches!(l, Light::Quad(q) if !q.is_rectangle()))
-        {
-            methods.quad = QuadMethod::Area;
-        }
-        methods
+            .selector(crate::lights::selector::default_selector())?;
+        let ctx = crate::lights::LightCtx { p, n: Vec3::ZERO };
+        self.lights.sample(sel, &ctx, u_select, u, methods)
     }
 }
 

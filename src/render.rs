@@ -1,73 +1,189 @@
 //! One sample per pixel over the whole image, in 4×4 tiles: a 16-ray camera packet, then the
-//! strategy's shadow and emission probes as two more packets. Parallel over tiles with rayon.
+//! estimator's shadow and emission probes as two more packets. Parallel over tiles with rayon.
+//!
+//! A pass runs in two phases per tile — the camera phase (sample values, camera rays, shading
+//! points) and the shading phase (probes, their packets, the radiance) — back to back, or, for
+//! an image-space estimator, the camera phase of every tile first, then the estimator's
+//! `begin_pass` with all shading points, then every tile's shading phase.
 
+use crate::error::{Error, Result};
 use crate::film::{Film, TileLayout, accumulate};
 use crate::geometry::Ray;
-use crate::prepare::PreparedScene;
-use crate::sampling::stream::{SampleStream, name_id};
+use crate::prepare::{PreparedScene, SceneView};
+use crate::sampling::generator::MAX_DIMENSIONS;
+use crate::sampling::stream::name_id;
+use crate::sampling::{Dims, GENERATORS, Layout, SampleGenerator, SampleKey};
 use crate::scene::Camera;
-use crate::strategy::{ShadingPoint, Strategy};
+use crate::strategy::{EmissionProbe, Estimator, PassPoints, Probes, ShadingPoint, Strategy};
 use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
 use glam::Vec3;
 use rayon::prelude::*;
 
 pub struct Renderer<'a> {
     pub scene: &'a PreparedScene,
-    pub strategy: &'a dyn Strategy,
+    pub view: SceneView<'a>,
+    estimator: Box<dyn Estimator + 'a>,
+    generator: &'a dyn SampleGenerator,
     pub seed: u64,
     strategy_id: u64,
+    /// Camera dimensions plus the estimator's.
+    dims: usize,
+    direct: bool,
+}
+
+/// A tile after its camera phase. Reused from tile to tile within a worker's share of a pass
+/// (rayon's `for_each_init`): 2 KiB of sample values are not cleared and copied per tile.
+struct CameraTile<'a> {
+    radiance: [Vec3; LANES],
+    points: [Option<ShadingPoint<'a>>; LANES],
+    values: [[f32; MAX_DIMENSIONS]; LANES],
+}
+
+impl CameraTile<'_> {
+    fn new() -> Self {
+        CameraTile {
+            radiance: [Vec3::ZERO; LANES],
+            points: [None; LANES],
+            values: [[0.0; MAX_DIMENSIONS]; LANES],
+        }
+    }
 }
 
 impl<'a> Renderer<'a> {
-    pub fn new(scene: &'a PreparedScene, strategy: &'a dyn Strategy, seed: u64) -> Self {
-        Renderer {
-            scene,
-            strategy,
-            seed,
-            strategy_id: name_id(strategy.name()),
-        }
+    /// `strategy` bound to `scene`, drawing from the default (independent) generator; an error
+    /// when the strategy does not apply there.
+    pub fn new(scene: &'a PreparedScene, strategy: &dyn Strategy, seed: u64) -> Result<Self> {
+        Self::with_generator(scene, strategy, seed, GENERATORS[0])
     }
 
-    /// Adds one sample per pixel to the film; pass `film.spp` numbers the random streams, so
-    /// the result is independent of thread count and scheduling.
-    pub fn add_pass(&self, film: &mut Film) {
+    pub fn with_generator(
+        scene: &'a PreparedScene,
+        strategy: &dyn Strategy,
+        seed: u64,
+        generator: &'a dyn SampleGenerator,
+    ) -> Result<Self> {
+        let integrand = strategy.integrand();
+        let view = scene.view(integrand);
+        let name = strategy.name();
+        let estimator = strategy.bind(view).map_err(|why| {
+            Error::Usage(format!(
+                "strategy `{name}` does not apply to scene `{}`: {why}",
+                scene.scene.name
+            ))
+        })?;
+        let dims = Layout::camera().len() + estimator.layout().len();
+        if dims > MAX_DIMENSIONS {
+            return Err(Error::Usage(format!(
+                "strategy `{name}` lays out {dims} sample dimensions; at most {MAX_DIMENSIONS} are supported"
+            )));
+        }
+        Ok(Renderer {
+            scene,
+            view,
+            estimator,
+            generator,
+            seed,
+            strategy_id: name_id(&name),
+            dims,
+            direct: integrand.is_direct(),
+        })
+    }
+
+    pub fn estimator(&self) -> &dyn Estimator {
+        self.estimator.as_ref()
+    }
+
+    /// Adds one sample per pixel to the film; pass `film.spp` numbers the samples, so the
+    /// result is independent of thread count and scheduling.
+    pub fn add_pass(&mut self, film: &mut Film) {
         self.add_pass_with_stream(film, film.spp);
     }
 
-    /// Adds one sample per pixel drawn from the random streams of pass `stream`, which need
-    /// not be the film's next pass: shard i of n renders passes i, i + n, … (see
-    /// `harness::shard`), and the merged film equals a sequential render's up to roundoff.
-    pub fn add_pass_with_stream(&self, film: &mut Film, stream: u64) {
+    /// Adds one sample per pixel with sample index `stream`, which need not be the film's
+    /// next pass: shard i of n renders passes i, i + n, … (see `harness::shard`), and the
+    /// merged film equals a sequential render's up to roundoff.
+    pub fn add_pass_with_stream(&mut self, film: &mut Film, stream: u64) {
         let count = film.spp;
         let layout = film.layout;
-        film.sum
-            .par_chunks_mut(16)
-            .zip(film.m2.par_chunks_mut(16))
-            .enumerate()
-            .for_each(|(tile, (sum, m2))| {
-                let radiance = self.render_tile(&layout, tile, stream);
-                for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
-                    accumulate(s, m, count, [l.x as f64, l.y as f64, l.z as f64]);
+        if self.estimator.wants_pass_points() {
+            let tiles: Vec<CameraTile> = (0..layout.tile_count())
+                .into_par_iter()
+                .map(|t| {
+                    let mut tile = CameraTile::new();
+                    self.camera_phase(&layout, t, stream, &mut tile);
+                    tile
+                })
+                .collect();
+            let mut pass = PassPoints {
+                width: layout.width,
+                height: layout.height,
+                points: vec![None; (layout.width * layout.height) as usize],
+            };
+            for (t, tile) in tiles.iter().enumerate() {
+                for (lane, p) in tile.points.iter().enumerate() {
+                    if let Some((x, y)) = layout.lane_pixel(t, lane) {
+                        pass.points[(y * layout.width + x) as usize] = *p;
+                    }
                 }
-            });
+            }
+            self.estimator.begin_pass(&pass);
+            let this = &*self;
+            film.sum
+                .par_chunks_mut(16)
+                .zip(film.m2.par_chunks_mut(16))
+                .zip(tiles.par_iter())
+                .for_each(|((sum, m2), tile)| {
+                    let radiance = this.shading_phase(tile);
+                    for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
+                        accumulate(s, m, count, [l.x as f64, l.y as f64, l.z as f64]);
+                    }
+                });
+        } else {
+            let this = &*self;
+            film.sum
+                .par_chunks_mut(16)
+                .zip(film.m2.par_chunks_mut(16))
+                .enumerate()
+                .for_each_init(CameraTile::new, |tile, (t, (sum, m2))| {
+                    this.camera_phase(&layout, t, stream, tile);
+                    let radiance = this.shading_phase(tile);
+                    for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
+                        accumulate(s, m, count, [l.x as f64, l.y as f64, l.z as f64]);
+                    }
+                });
+        }
         film.spp += 1;
     }
 
-    fn render_tile(&self, shape: &TileLayout, tile: usize, pass: u64) -> [Vec3; LANES] {
+    /// Sample values, the camera packet, what the camera sees directly (emitters, the
+    /// environment) and the shading points.
+    fn camera_phase(&self, shape: &TileLayout, tile: usize, pass: u64, out: &mut CameraTile<'a>) {
         let scene = self.scene;
         let camera = &scene.scene.camera;
         let (w, h) = (shape.width, shape.height);
-        let mut radiance = [Vec3::ZERO; LANES];
-        let mut rngs: [Option<SampleStream>; LANES] = Default::default();
+        out.radiance = [Vec3::ZERO; LANES];
+        out.points = [None; LANES];
         let mut cam = RayPacket::default();
         let mut active: LaneMask = 0;
-        for (lane, slot) in rngs.iter_mut().enumerate() {
+        let mut pixels = [u32::MAX; LANES];
+        for (lane, pixel_of) in pixels.iter_mut().enumerate() {
             if let Some((x, y)) = shape.lane_pixel(tile, lane) {
-                let pixel = y as u64 * w as u64 + x as u64;
-                let mut rng = SampleStream::new(self.seed, self.strategy_id, pixel, pass);
-                let ray = camera_ray(camera, w, h, x, y, rng.next_2d());
-                cam.set(lane, &ray);
-                *slot = Some(rng);
+                let pixel = y * w + x;
+                let values = &mut out.values[lane][..self.dims];
+                self.generator.fill(
+                    SampleKey {
+                        seed: self.seed,
+                        strategy: self.strategy_id,
+                        pixel: pixel as u64,
+                        index: pass,
+                    },
+                    values,
+                );
+                cam.set(
+                    lane,
+                    &camera_ray(camera, w, h, x, y, [values[0], values[1]]),
+                );
+                *pixel_of = pixel;
                 active |= 1 << lane;
             }
         }
@@ -75,56 +191,68 @@ impl<'a> Renderer<'a> {
         scene
             .tracer
             .intersect_packet_coherent(&cam, active, &mut hits);
-
-        let mut shadow = RayPacket::default();
-        let mut shadow_value = [Vec3::ZERO; LANES];
-        let mut shadow_mask: LaneMask = 0;
-        let mut emit = RayPacket::default();
-        let mut emit_probe = [None; LANES];
-        let mut emit_mask: LaneMask = 0;
-        let mut points: [Option<ShadingPoint>; LANES] = [None; LANES];
-        let direct = self.strategy.integrand().is_direct();
-        for lane in 0..LANES {
-            let Some(rng) = rngs[lane].as_mut() else {
+        for (lane, &pixel) in pixels.iter().enumerate() {
+            if active & (1 << lane) == 0 {
                 continue;
-            };
+            }
             let ray = cam.get(lane);
             let Some(hit) = hits.get(lane) else {
                 // The camera sees the environment (zero without one).
-                if direct {
-                    radiance[lane] += scene.env_radiance(self.strategy.env_repr(), ray.dir);
+                if self.direct {
+                    out.radiance[lane] += self.view.env_radiance(ray.dir);
                 }
                 continue;
             };
-            let surf = scene.surface(&ray, &hit);
-            if direct {
-                radiance[lane] += scene.emitted(&surf, ray.dir);
+            let surf = scene.world.surface(&ray, &hit);
+            if self.direct {
+                out.radiance[lane] += self.view.emitted(&surf, ray.dir);
             }
-            let sp = ShadingPoint::with_error(
+            let mut sp = ShadingPoint::with_error(
                 surf.p,
                 surf.p_error,
                 surf.ng,
                 ray.dir,
-                scene.bsdfs[surf.material as usize],
+                &scene.world.materials[surf.material as usize],
             );
-            let probes = self.strategy.sample(scene, &sp, rng);
-            points[lane] = Some(sp);
-            if let Some(s) = probes.shadow {
+            sp.pixel = pixel;
+            out.points[lane] = Some(sp);
+        }
+    }
+
+    /// The estimator's probes for the tile's points, traced as packets.
+    fn shading_phase(&self, tile: &CameraTile) -> [Vec3; LANES] {
+        let scene = self.scene;
+        let mut radiance = tile.radiance;
+        let mut dims: [Dims; LANES] =
+            std::array::from_fn(|lane| Dims::new(&tile.values[lane][2..self.dims]));
+        let mut probes = [Probes::default(); LANES];
+        self.estimator
+            .sample_packet(&tile.points, &mut dims, &mut probes);
+
+        let mut shadow = RayPacket::default();
+        let mut shadow_mask: LaneMask = 0;
+        let mut emit = RayPacket::default();
+        let mut emit_mask: LaneMask = 0;
+        for (lane, p) in probes.iter().enumerate() {
+            if tile.points[lane].is_none() {
+                continue;
+            }
+            if let Some(s) = p.shadow {
                 shadow.set(lane, &s.ray);
-                shadow_value[lane] = s.value;
                 shadow_mask |= 1 << lane;
             }
-            if let Some(e) = probes.emission {
+            if let Some(e) = p.emission {
                 emit.set(lane, &e.ray);
-                emit_probe[lane] = Some(e);
                 emit_mask |= 1 << lane;
             }
         }
         if shadow_mask != 0 {
             let blocked = scene.tracer.occluded_packet(&shadow, shadow_mask);
-            for lane in 0..LANES {
-                if shadow_mask & !blocked & (1 << lane) != 0 {
-                    radiance[lane] += shadow_value[lane];
+            for (lane, p) in probes.iter().enumerate() {
+                if shadow_mask & !blocked & (1 << lane) != 0
+                    && let Some(s) = p.shadow
+                {
+                    radiance[lane] += s.value;
                 }
             }
         }
@@ -132,12 +260,14 @@ impl<'a> Renderer<'a> {
             let mut ehits = HitPacket::default();
             scene.tracer.intersect_packet(&emit, emit_mask, &mut ehits);
             for lane in 0..LANES {
-                let (Some(probe), Some(sp)) = (emit_probe[lane], points[lane]) else {
+                let (Some(probe), Some(sp)) = (probes[lane].emission, &tile.points[lane]) else {
                     continue;
                 };
                 radiance[lane] += match ehits.get(lane) {
-                    Some(hit) => emission_contribution(scene, self.strategy, &sp, &probe, &hit),
-                    None => escape_contribution(scene, self.strategy, &sp, &probe),
+                    Some(hit) => {
+                        emission_contribution(&self.view, self.estimator(), sp, &probe, &hit)
+                    }
+                    None => escape_contribution(&self.view, self.estimator(), sp, &probe),
                 };
             }
         }
@@ -157,36 +287,36 @@ pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ra
     )
 }
 
-/// What an emission probe that escaped the scene adds: weight · L_env · the strategy's MIS
-/// weight, with the environment in the strategy's representation (zero without one).
+/// What an emission probe that escaped the scene adds: weight · L_env · the estimator's MIS
+/// weight, with the environment in the view's representation (zero without one).
 pub fn escape_contribution(
-    scene: &PreparedScene,
-    strategy: &dyn Strategy,
+    view: &SceneView,
+    estimator: &dyn Estimator,
     sp: &ShadingPoint,
-    probe: &crate::strategy::EmissionProbe,
+    probe: &EmissionProbe,
 ) -> Vec3 {
-    let le = scene.env_radiance(strategy.env_repr(), probe.ray.dir);
+    let le = view.env_radiance(probe.ray.dir);
     if le == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    probe.weight * le * strategy.env_weight(scene, sp, probe)
+    probe.weight * le * estimator.env_weight(sp, probe)
 }
 
-/// What an emission probe that hit `hit` adds: weight · Le · the strategy's MIS weight.
+/// What an emission probe that hit `hit` adds: weight · Le · the estimator's MIS weight.
 pub fn emission_contribution(
-    scene: &PreparedScene,
-    strategy: &dyn Strategy,
+    view: &SceneView,
+    estimator: &dyn Estimator,
     sp: &ShadingPoint,
-    probe: &crate::strategy::EmissionProbe,
+    probe: &EmissionProbe,
     hit: &crate::geometry::Hit,
 ) -> Vec3 {
-    if scene.prim_emitter[hit.prim as usize].is_none() {
+    if view.world.prim_emitter[hit.prim as usize].is_none() {
         return Vec3::ZERO;
     }
-    let surf = scene.surface(&probe.ray, hit);
-    let le = scene.emitted(&surf, probe.ray.dir);
+    let surf = view.world.surface(&probe.ray, hit);
+    let le = view.emitted(&surf, probe.ray.dir);
     if le == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    probe.weight * le * strategy.emission_weight(scene, sp, probe, &surf)
+    probe.weight * le * estimator.emission_weight(sp, probe, &surf)
 }

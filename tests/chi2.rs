@@ -81,8 +81,8 @@ fn discrete_distribution_chi2() {
 /// sphere) is rejected.
 #[test]
 fn an_environment_pdf_without_its_jacobian_fails() {
-    use dibench::chi2::registry::synthetic_environment;
     use dibench::chi2::{Chart, WarpCase};
+    use dibench::env::synthetic_environment;
     use dibench::env::{EnvMethod, EnvSampler, Environment, Repr};
     use std::sync::Arc;
     let m = EnvMethod {

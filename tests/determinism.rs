@@ -17,7 +17,7 @@ fn render(scene: &PreparedScene, strategy: &str, seed: u64, threads: usize) -> I
         .find(|s| s.name() == strategy)
         .unwrap();
     pool.install(|| {
-        let r = Renderer::new(scene, strategy.as_ref(), seed);
+        let mut r = Renderer::new(scene, strategy.as_ref(), seed).unwrap();
         let mut film = Film::new(scene.scene.width, scene.scene.height);
         for _ in 0..3 {
             r.add_pass(&mut film);

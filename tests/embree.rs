@@ -23,7 +23,7 @@ fn load(name: &str) -> PreparedScene {
 /// Rays from random points in (a box slightly larger than) the scene's bounds in uniformly
 /// random directions; every third one gets a finite tmax.
 fn random_rays(scene: &PreparedScene, n: usize, seed: u64) -> Vec<Ray> {
-    let g = &scene.geometry;
+    let g = &scene.world.geometry;
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for t in &g.triangles {
         for v in [t.v0, t.v1, t.v2] {
@@ -74,7 +74,7 @@ fn same(scene: &PreparedScene, ray: &Ray, a: Option<Hit>, b: Option<Hit>) -> boo
 fn embree_matches_obvhs_on_random_rays_single_and_partial_packets() {
     for name in SCENES {
         let scene = load(name);
-        let embree = EmbreeTracer::build(scene.geometry.clone()).unwrap();
+        let embree = EmbreeTracer::build(scene.world.geometry.clone()).unwrap();
         let rays = random_rays(&scene, 4096, 5);
         let mut bad = 0;
         let mut hits_seen = 0;
@@ -130,14 +130,14 @@ fn embree_matches_obvhs_on_random_rays_single_and_partial_packets() {
 fn primitive_ids_barycentrics_and_spheres_map_back() {
     // sphere_light has both triangles and spheres; hit points must agree through (u, v).
     let scene = load("sphere_light");
-    assert!(!scene.geometry.spheres.is_empty());
-    let embree = EmbreeTracer::build(scene.geometry.clone()).unwrap();
+    assert!(!scene.world.geometry.spheres.is_empty());
+    let embree = EmbreeTracer::build(scene.world.geometry.clone()).unwrap();
     let (mut tri, mut sph) = (0, 0);
     for ray in random_rays(&scene, 4096, 11) {
         if let Some(h) = embree.intersect(&ray) {
             let s = scene.surface(&ray, &h);
             assert!((s.p - ray.at(h.t)).length() < 1e-3 * h.t.max(1.0), "{h:?}");
-            match scene.geometry.sphere_index(h.prim) {
+            match scene.world.geometry.sphere_index(h.prim) {
                 Some(_) => sph += 1,
                 None => tri += 1,
             }
@@ -149,7 +149,7 @@ fn primitive_ids_barycentrics_and_spheres_map_back() {
 #[test]
 fn empty_packet_and_tracer_name() {
     let scene = load("cornell");
-    let embree = EmbreeTracer::build(scene.geometry.clone()).unwrap();
+    let embree = EmbreeTracer::build(scene.world.geometry.clone()).unwrap();
     assert_eq!(embree.name(), "embree");
     let mut h = HitPacket::default();
     embree.intersect_packet(&RayPacket::default(), 0, &mut h);

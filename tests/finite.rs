@@ -14,7 +14,7 @@ fn every_strategy_on_every_scene_is_finite() {
         let scene = PreparedScene::new(Scene::load(&Scene::resolve(&name).unwrap()).unwrap());
         let (strategies, _) = applicable(&scene);
         for s in &strategies {
-            let r = Renderer::new(&scene, s.as_ref(), 5);
+            let mut r = Renderer::new(&scene, s.as_ref(), 5).unwrap();
             let mut film = Film::new(scene.scene.width, scene.scene.height);
             for _ in 0..4 {
                 r.add_pass(&mut film);

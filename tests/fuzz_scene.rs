@@ -105,9 +105,11 @@ fn mutated_scenes_parse_or_fail_cleanly() {
                     scene.height = scene.height.min(8);
                     let prepared = PreparedScene::new(scene);
                     let s = by_name("light").unwrap();
-                    if s.applies(&prepared).is_ok() {
+                    if dibench::strategy::applies(s.as_ref(), &prepared).is_ok() {
                         let mut film = Film::new(prepared.scene.width, prepared.scene.height);
-                        Renderer::new(&prepared, s.as_ref(), 1).add_pass(&mut film);
+                        Renderer::new(&prepared, s.as_ref(), 1)
+                            .unwrap()
+                            .add_pass(&mut film);
                         let img = film.mean();
                         assert!(
                             img.pixels.iter().flatten().all(|c| c.is_finite()),

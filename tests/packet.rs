@@ -25,7 +25,7 @@ fn random_packets(sc: &PreparedScene, n: usize, seed: u64) -> Vec<(RayPacket, La
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let mut f = move || (rng.next_u32() >> 8) as f32 / (1 << 24) as f32;
     let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-    for t in &sc.geometry.triangles {
+    for t in &sc.world.geometry.triangles {
         for v in [t.v0, t.v1, t.v2] {
             lo = lo.min(v);
             hi = hi.max(v);
@@ -135,11 +135,11 @@ fn check_occluded(base: &ObvhsTracer, tr: &PacketTracer, p: &RayPacket, m: LaneM
 
 fn agree_on(name: &str) {
     let sc = scene(name);
-    let base = ObvhsTracer::build(sc.geometry.clone());
+    let base = ObvhsTracer::build(sc.world.geometry.clone());
     let sets = rays::generate(&sc, 48, 7);
     let random = random_packets(&sc, 400, 11);
     for isa in Isa::available() {
-        let tr = PacketTracer::build(sc.geometry.clone(), isa).unwrap();
+        let tr = PacketTracer::build(sc.world.geometry.clone(), isa).unwrap();
         let mut tally = Tally::default();
         for set in &sets {
             for (p, &m) in set.packets.iter().zip(&set.masks) {
@@ -194,11 +194,11 @@ fn packet_renders_same_image_as_obvhs() {
             Box::new(PacketTracer::build(g, isa).unwrap())
         });
         for s in registry() {
-            if s.applies(&a).is_err() {
+            if dibench::strategy::applies(s.as_ref(), &a).is_err() {
                 continue;
             }
             let img = |sc: &PreparedScene| {
-                let r = Renderer::new(sc, s.as_ref(), 3);
+                let mut r = Renderer::new(sc, s.as_ref(), 3).unwrap();
                 let mut film = Film::new(sc.scene.width, sc.scene.height);
                 for _ in 0..2 {
                     r.add_pass(&mut film);

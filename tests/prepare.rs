@@ -4,7 +4,8 @@
 //! selection distribution only when there is a light; and every strategy that does not apply
 //! is skipped with a reason. Checked on every built-in scene.
 
-use dibench::lights::Light;
+use dibench::lights::LightShape;
+use dibench::lights::selector::default_selector;
 use dibench::prepare::PreparedScene;
 use dibench::scene::Scene;
 use dibench::strategy::{Integrand, applicable, integrands};
@@ -30,8 +31,13 @@ fn prepare_builds_only_what_the_scene_declares() {
         let name = scene.name.clone();
         let s = &scene;
         let emitting = |e: Option<glam::Vec3>| e.is_some_and(|e| e.max_element() > 0.0);
-        let count =
-            |k: fn(&Light) -> bool, p: &PreparedScene| p.lights.iter().filter(|l| k(l)).count();
+        let count = |shape: LightShape, p: &PreparedScene| {
+            p.lights
+                .lights()
+                .iter()
+                .filter(|l| l.shape() == shape)
+                .count()
+        };
         let quads = s.quads.iter().filter(|q| emitting(q.emission)).count();
         let spheres = s.spheres.iter().filter(|q| emitting(q.emission)).count();
         let meshes = s.meshes.iter().filter(|q| emitting(q.emission)).count();
@@ -45,49 +51,32 @@ fn prepare_builds_only_what_the_scene_declares() {
         let n_spheres = s.spheres.len();
         let p = PreparedScene::new(scene);
 
+        for (shape, n) in [
+            (LightShape::Quad, quads),
+            (LightShape::Sphere, spheres),
+            (LightShape::Mesh, meshes),
+            (LightShape::Point, points + spots),
+            (LightShape::Direction, dirs),
+            (LightShape::Environment, has_env as usize),
+        ] {
+            assert_eq!(count(shape, &p), n, "{name}: {} lights", shape.name());
+        }
         assert_eq!(
-            count(|l| matches!(l, Light::Quad(_)), &p),
-            quads,
-            "{name}: quad lights"
-        );
-        assert_eq!(
-            count(|l| matches!(l, Light::Sphere(_)), &p),
-            spheres,
-            "{name}: sphere lights"
-        );
-        assert_eq!(
-            count(|l| matches!(l, Light::Mesh(_)), &p),
-            meshes,
-            "{name}: mesh lights"
-        );
-        assert_eq!(
-            count(|l| matches!(l, Light::Point(_)), &p),
-            points,
-            "{name}"
-        );
-        assert_eq!(count(|l| matches!(l, Light::Spot(_)), &p), spots, "{name}");
-        assert_eq!(
-            count(|l| matches!(l, Light::Directional(_)), &p),
-            dirs,
-            "{name}"
-        );
-        assert_eq!(
-            count(|l| matches!(l, Light::Environment(_)), &p),
-            has_env as usize,
-            "{name}"
-        );
-        assert_eq!(
-            p.geometry.spheres.len(),
+            p.world.geometry.spheres.len(),
             n_spheres,
             "{name}: analytic spheres"
         );
         assert_eq!(
-            p.environment.is_some(),
+            p.lights.environment().is_some(),
             has_env,
             "{name}: environment structures"
         );
-        assert_eq!(p.env_light.is_some(), has_env, "{name}");
-        assert_eq!(p.light_selection.is_some(), !p.lights.is_empty(), "{name}");
+        assert_eq!(p.lights.environment_index().is_some(), has_env, "{name}");
+        assert_eq!(
+            p.lights.selector(default_selector()).is_some(),
+            !p.lights.is_empty(),
+            "{name}"
+        );
         if has_env {
             seen_env.0 = true;
         } else {
@@ -95,7 +84,7 @@ fn prepare_builds_only_what_the_scene_declares() {
         }
 
         let ints = integrands(&p);
-        assert!(ints.contains(&Integrand::Direct), "{name}");
+        assert!(ints.contains(&Integrand::DIRECT), "{name}");
         assert_eq!(
             ints.contains(&Integrand::AmbientOcclusion),
             has_ao,

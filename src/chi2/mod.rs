@@ -2,13 +2,21 @@
 //! `ChiSquareTest`): histogram the samples on an equal-area grid of a spherical cap, integrate
 //! the sampler's pdf over each cell for the expected counts, pool cells expecting < 5, and take
 //! p = Q(dof/2, χ²/2). A sample where the pdf is zero, a non-finite sample, or a returned pdf
-//! that disagrees with `pdf()` is a hard failure. Samplers register in [`registry`].
+//! that disagrees with `pdf()` is a hard failure.
+//!
+//! Each sampler's cases live beside it (`chi2_cases()` in `sampling::warp`, `bsdf`, each
+//! light's file, `env`), built through one adapter, [`WarpCase`] (sample(u), pdf(ω), and the
+//! cap holding the support); [`registry`] only concatenates them.
 
 pub mod image;
 pub mod registry;
 
+use crate::geometry::Ray;
+use crate::geometry::triangle::{Triangle, WatertightRay};
+use crate::lights::{Light, LightCtx, LightHit, LightMethods};
 use crate::math::Frame;
 use glam::{DVec3, Vec3};
+use std::collections::BTreeMap;
 use std::f64::consts::PI;
 
 /// A spherical cap around `axis` with 1 - cos θ ≤ `h`, parameterised by
@@ -117,6 +125,162 @@ impl Chi2Result {
 /// Šidák-corrected per-test significance for a suite of `tests` at family-wise level `alpha`.
 pub fn sidak(alpha: f64, tests: usize) -> f64 {
     1.0 - (1.0 - alpha).powf(1.0 / tests as f64)
+}
+
+pub type Params = BTreeMap<String, f64>;
+
+/// Builds a case from parameters, or says why the parameters are invalid.
+pub type BuildFn = Box<dyn Fn(&Params) -> Result<WarpCase, String>>;
+
+/// A sampler as registered for the χ² suite and `dibench warp`: a name, its parameters with
+/// defaults, the parameter sets the test suite runs (extremes included), and a constructor
+/// that builds the [`WarpCase`] from parameters.
+pub struct WarpEntry {
+    pub name: String,
+    pub describe: &'static str,
+    /// Parameters and their defaults.
+    pub params: &'static [(&'static str, f64)],
+    /// Overrides the test suite runs, one parameter set each (empty: the defaults).
+    pub suite: &'static [&'static [(&'static str, f64)]],
+    /// The lecture's inconsistent pair: kept so the harness can show that it fails.
+    pub expect_fail: bool,
+    pub build: BuildFn,
+}
+
+impl WarpEntry {
+    pub fn new(
+        name: impl Into<String>,
+        describe: &'static str,
+        params: &'static [(&'static str, f64)],
+        suite: &'static [&'static [(&'static str, f64)]],
+        build: impl Fn(&Params) -> Result<WarpCase, String> + 'static,
+    ) -> Self {
+        WarpEntry {
+            name: name.into(),
+            describe,
+            params,
+            suite,
+            expect_fail: false,
+            build: Box::new(build),
+        }
+    }
+
+    /// Defaults overridden by `overrides`; unknown names are errors.
+    pub fn params(&self, overrides: &[(String, f64)]) -> Result<Params, String> {
+        let mut p: Params = self
+            .params
+            .iter()
+            .map(|(k, v)| (k.to_string(), *v))
+            .collect();
+        for (k, v) in overrides {
+            if !p.contains_key(k) {
+                let known: Vec<_> = self.params.iter().map(|(k, _)| *k).collect();
+                return Err(format!(
+                    "sampler `{}` has no parameter `{k}` (parameters: {})",
+                    self.name,
+                    known.join(", ")
+                ));
+            }
+            if !v.is_finite() {
+                return Err(format!("parameter `{k}` must be finite, got {v}"));
+            }
+            p.insert(k.clone(), *v);
+        }
+        Ok(p)
+    }
+
+    /// The parameter sets of the test suite.
+    pub fn suite_params(&self) -> Vec<Params> {
+        let sets: Vec<&[(&str, f64)]> = if self.suite.is_empty() {
+            vec![&[]]
+        } else {
+            self.suite.to_vec()
+        };
+        sets.into_iter()
+            .map(|s| {
+                self.params(
+                    &s.iter()
+                        .map(|(k, v)| (k.to_string(), *v))
+                        .collect::<Vec<_>>(),
+                )
+                .expect("suite parameters are valid")
+            })
+            .collect()
+    }
+}
+
+/// `name(k=v, ...)`: a case's label.
+pub fn label(name: &str, p: &Params) -> String {
+    let args: Vec<String> = p.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    format!("{name}({})", args.join(", "))
+}
+
+/// Parameter `k` as f32.
+pub fn param(p: &Params, k: &str) -> f32 {
+    p[k] as f32
+}
+
+/// 1 - cos θ about +z from a unit direction, exact near the pole.
+pub fn omc_z(w: Vec3) -> f32 {
+    if w.z > 0.0 {
+        (w.x * w.x + w.y * w.y) / (1.0 + w.z)
+    } else {
+        1.0 - w.z
+    }
+}
+
+/// The light adapter: a light seen from the origin, sampled by `methods`, with its pdf found
+/// by locating where a direction meets the light (`hit`: the point and the light's part) and
+/// asking the light's own pdf routine. The chart must hold the support.
+pub fn light_case(
+    label: String,
+    light: impl Light + 'static,
+    methods: LightMethods,
+    hit: impl Fn(Vec3) -> Option<(Vec3, u32)> + 'static,
+    chart: Chart,
+) -> WarpCase {
+    let light = std::sync::Arc::new(light);
+    let l2 = light.clone();
+    let ctx = LightCtx {
+        p: Vec3::ZERO,
+        n: chart.frame.n,
+    };
+    WarpCase {
+        label,
+        sample: Box::new(move |u| light.sample(&ctx, u, &methods).map(|s| (s.wi, s.pdf))),
+        pdf: Box::new(move |w| match hit(w) {
+            Some((q, local)) => l2.pdf(&ctx, LightHit::Surface { q, local }, &methods) as f64,
+            None => 0.0,
+        }),
+        mismatch_slack: DEFAULT_SLACK,
+        chart,
+    }
+}
+
+/// The smallest cap about the direction to `center` containing every point (a convex shape's
+/// solid angle is bounded by its vertices), with a margin for rounding.
+pub fn cap_around(center: Vec3, points: &[Vec3]) -> Chart {
+    let axis = center.normalize();
+    let h = points
+        .iter()
+        .map(|p| 0.5 * (axis.as_dvec3() - p.normalize().as_dvec3()).length_squared())
+        .fold(0.0f64, f64::max);
+    Chart::cap(axis, (h * 1.02).max(1e-9))
+}
+
+/// The first of `tris` a ray from the origin along `w` hits: the point and the index.
+pub fn first_hit(tris: &[Triangle], w: Vec3) -> Option<(Vec3, u32)> {
+    let ray = Ray::new(Vec3::ZERO, w, f32::INFINITY);
+    let wr = WatertightRay::new(w);
+    let mut best: Option<(f32, Vec3, u32)> = None;
+    for (i, t) in tris.iter().enumerate() {
+        if let Some(h) = t.intersect(&ray, &wr)
+            && best.is_none_or(|b| h.t < b.0)
+        {
+            best = Some((h.t, t.point(h.b1, h.b2), i as u32));
+        }
+    }
+    best.map(|(_, q, i)| (q, i))
 }
 
 /// Low-discrepancy-free, reproducible uniforms: a PCG stream per case.

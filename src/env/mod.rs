@@ -174,6 +174,63 @@ impl Environment {
     }
 }
 
+/// χ² cases: one per (representation, sampler), on [`synthetic_environment`].
+pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
+    crate::strategy::env_methods()
+        .map(|method| {
+            let name = format!("env-{}", crate::strategy::env_method_name(method));
+            crate::chi2::WarpEntry::new(
+                name.clone(),
+                "environment light importance sampling on a synthetic map (sun of relative strength `sun` + gradient + a black region), `tile` texels per tile side",
+                &[("sun", 50.0), ("tile", 16.0)],
+                &[&[], &[("sun", 1e4)], &[("sun", 0.0), ("tile", 32.0)]],
+                move |p| chi2_case(p, &name, method),
+            )
+        })
+        .collect()
+}
+
+/// A synthetic environment: a small bright sun, a sky gradient, and a black wedge (the sampler
+/// must never go there, and its pdf there must be zero). Not symmetric in φ, so a map mirrored
+/// in φ shows.
+pub fn synthetic_environment(sun: f32) -> impl Fn(Vec3) -> Vec3 + Sync {
+    let sun_dir = Vec3::new(0.5, 0.6, -0.4).normalize();
+    move |w: Vec3| {
+        if w.x > 0.2 && w.y < 0.0 {
+            return Vec3::ZERO;
+        }
+        let sky = Vec3::new(0.3, 0.5, 1.0) * (1.2 + w.y) + Vec3::splat(0.2 * w.z.abs());
+        let s = if w.dot(sun_dir) > 0.995 { sun } else { 0.0 };
+        sky + Vec3::new(1.0, 0.9, 0.7) * s
+    }
+}
+
+fn chi2_case(
+    p: &crate::chi2::Params,
+    name: &str,
+    method: EnvMethod,
+) -> Result<crate::chi2::WarpCase, String> {
+    use crate::chi2::{Chart, DEFAULT_SLACK, WarpCase, label, param};
+    let (sun, tile) = (param(p, "sun"), p["tile"]);
+    if sun.is_nan() || sun < 0.0 {
+        return Err("sun must be non-negative".into());
+    }
+    if !((1.0..=512.0).contains(&tile) && tile.fract() == 0.0 && (tile as usize).is_power_of_two())
+    {
+        return Err("tile must be a power of two in 1..=512".into());
+    }
+    let n = tile as usize;
+    let env = std::sync::Arc::new(Environment::build_with(&synthetic_environment(sun), [n; 4]));
+    let env2 = env.clone();
+    Ok(WarpCase {
+        label: label(name, p),
+        sample: Box::new(move |u| env.sample(method, [u[0], u[1]]).map(|s| (s.wi, s.pdf))),
+        pdf: Box::new(move |w| env2.pdf(method, w) as f64),
+        mismatch_slack: DEFAULT_SLACK,
+        chart: Chart::sphere(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -62,7 +62,7 @@ struct RunMeta<'a> {
     runs: u32,
     seeds: Vec<u64>,
     budget_s: f64,
-    strategies: Vec<&'a str>,
+    strategies: Vec<String>,
     skipped: &'a [Skipped],
     reference_spp: &'a [(String, u64)],
     reference_noise_floor: &'a [(String, Option<f64>)],
@@ -103,9 +103,10 @@ pub fn run_strategy(
     opts: &CompareOptions,
     run: u32,
     mut on_progress: impl FnMut(Duration),
-) -> StrategyRun {
+) -> Result<StrategyRun> {
     let seed = opts.seed + run as u64;
-    let renderer = Renderer::new(scene, strategy, seed);
+    let mut renderer = Renderer::new(scene, strategy, seed)?;
+    let name = strategy.name();
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let budget = Duration::from_secs_f64(opts.time_s);
     let checkpoint_at = |k: u32| budget.div_f64(2f64.powi((CHECKPOINTS - 1 - k) as i32));
@@ -117,7 +118,7 @@ pub fn run_strategy(
         let image = film.mean();
         ResultRow {
             scene: scene.scene.name.clone(),
-            strategy: strategy.name().to_string(),
+            strategy: name.clone(),
             integrand: strategy.integrand().name().to_string(),
             backend: scene.tracer.name().to_string(),
             threads: opts.threads,
@@ -155,13 +156,13 @@ pub fn run_strategy(
     }
     // The last row is always the final image at the (bounded) budget.
     rows.push(row(&film, CHECKPOINTS - 1, elapsed));
-    StrategyRun {
+    Ok(StrategyRun {
         image: film.mean(),
         variance: film.variance_of_mean(),
         rows,
         mean_sample_variance: film.mean_sample_variance(),
         interrupted,
-    }
+    })
 }
 
 pub struct CompareReport {
@@ -324,7 +325,7 @@ pub fn run(
             })?;
             let r = run_strategy(scene, s.as_ref(), &reference.image, opts, run, |t| {
                 bar.set_position(t.as_millis() as u64);
-            });
+            })?;
             bar.finish_and_clear();
             if r.interrupted {
                 // Keep what finished (results.csv is already written), summarise it, record

@@ -125,7 +125,7 @@ fn pack(rays: &[Ray]) -> (RayPacket, u16) {
 
 /// Distance at which our exact test hits primitive `prim`, if it does.
 pub fn exact_t(scene: &PreparedScene, ray: &Ray, prim: u32) -> Option<f32> {
-    let g = &scene.geometry;
+    let g = &scene.world.geometry;
     match g.sphere_index(prim) {
         None => g
             .triangles
@@ -237,13 +237,13 @@ pub fn render(
     strategy: &dyn strategy::Strategy,
     seed: u64,
     passes: u64,
-) -> Image {
-    let r = Renderer::new(scene, strategy, seed);
+) -> Result<Image> {
+    let mut r = Renderer::new(scene, strategy, seed)?;
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     for _ in 0..passes {
         r.add_pass(&mut film);
     }
-    film.mean()
+    Ok(film.mean())
 }
 
 fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
@@ -260,7 +260,7 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
     let names = backends::AVAILABLE;
     let tracers: Vec<Box<dyn Tracer>> = names
         .iter()
-        .map(|n| backends::build(n, scene.geometry.clone()))
+        .map(|n| backends::build(n, scene.world.geometry.clone()))
         .collect::<Result<_>>()?;
     let modes = [Mode::Single, Mode::Packet16];
     let scene_name = scene.scene.name.clone();
@@ -327,11 +327,11 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
     // rare tie resolved differently, which changes a sample path).
     let (applicable, _) = strategy::applicable(scene);
     if let Some(strategy) = applicable.first() {
-        let reference = render(scene, strategy.as_ref(), seed, RENDER_PASSES);
+        let reference = render(scene, strategy.as_ref(), seed, RENDER_PASSES)?;
         for name in names.iter().skip(1) {
-            let tracer = backends::build(name, scene.geometry.clone())?;
+            let tracer = backends::build(name, scene.world.geometry.clone())?;
             let original = std::mem::replace(&mut scene.tracer, tracer);
-            let img = render(scene, strategy.as_ref(), seed, RENDER_PASSES);
+            let img = render(scene, strategy.as_ref(), seed, RENDER_PASSES)?;
             scene.tracer = original;
             let d = image_rel_rmse(&reference, &img);
             let pass = d <= MAX_IMAGE_REL_RMSE;

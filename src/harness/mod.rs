@@ -8,9 +8,6 @@ pub mod reference;
 pub mod shard;
 pub mod summary;
 
-use crate::film::{Film, Image};
-use crate::render::Renderer;
-
 /// Build provenance written into every metadata file.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 pub const COMMIT: &str = env!("DIBENCH_COMMIT");
@@ -27,22 +24,6 @@ pub fn cpu_model() -> String {
                 .map(|(_, v)| v.trim().to_string())
         })
         .unwrap_or_else(|| "unknown".into())
-}
-
-/// Renders `spp` passes with a renderer; the single place where whole images are made.
-pub fn render_spp(
-    renderer: &Renderer,
-    width: u32,
-    height: u32,
-    spp: u64,
-    mut on_pass: impl FnMut(u64),
-) -> Image {
-    let mut film = Film::new(width, height);
-    for _ in 0..spp {
-        renderer.add_pass(&mut film);
-        on_pass(film.spp);
-    }
-    film.mean()
 }
 
 /// A progress bar on stderr (hidden when stderr is not a terminal).

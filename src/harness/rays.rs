@@ -201,7 +201,7 @@ impl Subject {
 
 /// Builds the subjects for `--backend` names: `packet` expands to every ISA in `isas`.
 pub fn subjects(scene: &PreparedScene, backends: &[String], isas: &[Isa]) -> Result<Vec<Subject>> {
-    let geometry: Arc<_> = scene.geometry.clone();
+    let geometry: Arc<_> = scene.world.geometry.clone();
     let mut out = vec![];
     for b in backends {
         match b.as_str() {

@@ -54,13 +54,8 @@ pub fn generate(scene: &PreparedScene, seed: u64) -> Vec<RaySet> {
             continue;
         };
         let surf = scene.surface(ray, &hit);
-        let sp = ShadingPoint::with_error(
-            surf.p,
-            surf.p_error,
-            surf.ng,
-            ray.dir,
-            crate::bsdf::Bsdf::lambertian(glam::Vec3::ONE),
-        );
+        let white = crate::bsdf::Bsdf::lambertian(glam::Vec3::ONE);
+        let sp = ShadingPoint::with_error(surf.p, surf.p_error, surf.ng, ray.dir, &white);
         let u_select = rng.next_1d();
         let u = [rng.next_1d(), rng.next_1d(), rng.next_1d()];
         if let Some(r) = scene

@@ -110,7 +110,7 @@ pub fn render_progressive(
         Budget::Time(t) => (u64::MAX, Some(Duration::from_secs_f64(t))),
     };
     let strategy = strategy_for(scene, integrand)?;
-    let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
+    let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
     let bar = progress_bar(
         if time.is_some() { 0 } else { spp },
         format!("reference {} {}", scene.scene.name, integrand.name()),
@@ -126,7 +126,7 @@ pub fn render_progressive(
         height: scene.scene.height,
         spp: film.spp,
         seed,
-        strategy: strategy.name().to_string(),
+        strategy: strategy.name(),
         backend: scene.tracer.name().to_string(),
         threads,
         wall_time_s: start.elapsed().as_secs_f64(),

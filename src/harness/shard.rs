@@ -80,7 +80,7 @@ pub fn render(
         return Err(Error::Usage("--spp must be at least 1".into()));
     }
     let strategy = strategy_for(scene, integrand)?;
-    let renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed));
+    let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let start = Instant::now();
     for pass in (spec.index..total_spp).step_by(spec.count as usize) {

@@ -1,7 +1,7 @@
 //! Directional (distant) light: irradiance E⊥ arriving along one direction, E = E⊥·cos θ.
 //! Its shadow ray is unbounded.
 
-use super::LightSample;
+use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape};
 use crate::math::luminance;
 use glam::Vec3;
 
@@ -15,11 +15,7 @@ pub struct DirectionalLight {
 }
 
 impl DirectionalLight {
-    pub fn power(&self) -> f32 {
-        std::f32::consts::PI * self.scene_radius * self.scene_radius * luminance(self.irradiance)
-    }
-
-    pub fn sample(&self) -> LightSample {
+    pub fn sample_direction(&self) -> LightSample {
         LightSample {
             wi: self.to_light,
             point: Vec3::ZERO,
@@ -29,5 +25,24 @@ impl DirectionalLight {
             pdf: 1.0,
             distant: true,
         }
+    }
+}
+
+impl Light for DirectionalLight {
+    fn shape(&self) -> LightShape {
+        LightShape::Direction
+    }
+
+    fn power(&self) -> f32 {
+        std::f32::consts::PI * self.scene_radius * self.scene_radius * luminance(self.irradiance)
+    }
+
+    fn sample(&self, _ctx: &LightCtx, _u: [f32; 3], _m: &LightMethods) -> Option<LightSample> {
+        Some(self.sample_direction())
+    }
+
+    /// A delta light: no sampled direction reaches it.
+    fn pdf(&self, _ctx: &LightCtx, _at: LightHit, _m: &LightMethods) -> f32 {
+        0.0
     }
 }

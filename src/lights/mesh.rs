@@ -2,7 +2,9 @@
 //! Area sampling: a triangle chosen with probability A_i/A, then a uniform point on it, so the
 //! area pdf is 1/A over the whole mesh; converted to solid angle by d²/|cos θ_l|.
 
-use super::{LightSample, direction_to};
+use super::{
+    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, MeshMethod, direction_to,
+};
 use crate::geometry::triangle::Triangle;
 use crate::math::gamma;
 use crate::math::luminance;
@@ -37,10 +39,6 @@ impl MeshLight {
             by_area,
             radiance,
         })
-    }
-
-    pub fn power(&self) -> f32 {
-        std::f32::consts::PI * self.area * luminance(self.radiance)
     }
 
     /// u[2] picks the triangle (a fresh dimension, not a rescaled one: with 1e8 area ratios a
@@ -148,4 +146,105 @@ impl MeshLight {
             None => self.pdf_area(p, q, i),
         }
     }
+}
+
+impl Light for MeshLight {
+    fn shape(&self) -> LightShape {
+        LightShape::Mesh
+    }
+
+    fn power(&self) -> f32 {
+        std::f32::consts::PI * self.area * luminance(self.radiance)
+    }
+
+    fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
+        match m.mesh {
+            MeshMethod::Area => self.sample_area(ctx.p, u),
+            MeshMethod::SolidAngle => self.sample_solid_angle(ctx.p, u),
+        }
+    }
+
+    fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {
+        let LightHit::Surface { q, local } = at else {
+            return 0.0;
+        };
+        match m.mesh {
+            MeshMethod::Area => self.pdf_area(ctx.p, q, local as usize),
+            MeshMethod::SolidAngle => self.pdf_solid_angle(ctx.p, q, local as usize),
+        }
+    }
+
+    /// One-sided: front faces (counter-clockwise winding).
+    fn emitted(&self, n: Vec3, w: Vec3, _local: u32) -> Vec3 {
+        if n.dot(w) > 0.0 {
+            self.radiance
+        } else {
+            Vec3::ZERO
+        }
+    }
+}
+
+/// χ² cases: four coplanar triangles of unequal area facing down onto the origin from
+/// `height`, sampled by each method.
+pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
+    MeshMethod::ALL
+        .into_iter()
+        .map(|method| {
+            let name = match method {
+                MeshMethod::Area => "mesh-area",
+                MeshMethod::SolidAngle => "mesh-solid-angle",
+            };
+            crate::chi2::WarpEntry::new(
+                name,
+                match method {
+                    MeshMethod::Area => "mesh light, triangle by area then uniform by area",
+                    MeshMethod::SolidAngle => {
+                        "mesh light, triangle by area then spherical triangle (Arvo 1995)"
+                    }
+                },
+                &[("height", 1.2)],
+                &[&[], &[("height", 0.3)], &[("height", 20.0)]],
+                move |p| chi2_case(p, name, method),
+            )
+        })
+        .collect()
+}
+
+fn chi2_case(
+    p: &crate::chi2::Params,
+    name: &str,
+    method: MeshMethod,
+) -> Result<crate::chi2::WarpCase, String> {
+    use crate::chi2::{cap_around, first_hit, label, light_case, param};
+    let h = param(p, "height");
+    if h <= 0.0 {
+        return Err("height must be positive".into());
+    }
+    let v = [
+        Vec3::new(-0.6, -0.5, h),
+        Vec3::new(0.7, -0.4, h),
+        Vec3::new(0.5, 0.6, h),
+        Vec3::new(-0.4, 0.5, h),
+        Vec3::new(0.0, 0.9, h),
+        Vec3::new(-0.1, -0.9, h),
+    ];
+    let faces = [[0usize, 2, 1], [0, 3, 2], [3, 4, 2], [0, 1, 5]];
+    let tris: Vec<Triangle> = faces
+        .iter()
+        .map(|f| Triangle::new(v[f[0]], v[f[1]], v[f[2]]))
+        .collect();
+    debug_assert!(tris.iter().all(|t| t.cross().z < 0.0));
+    let light = MeshLight::new(tris.clone(), Vec3::ONE).ok_or("degenerate mesh")?;
+    let chart = cap_around(Vec3::new(0.0, 0.0, h), &v);
+    let methods = LightMethods {
+        mesh: method,
+        ..LightMethods::BASIC
+    };
+    Ok(light_case(
+        label(name, p),
+        light,
+        methods,
+        move |w| first_hit(&tris, w),
+        chart,
+    ))
 }

@@ -1,5 +1,7 @@
-//! Light sources with their samplers and pdfs side by side, one file per light type.
-//! Every sampler returns its pdf in solid angle at the shading point, the measure of the
+//! Light sources with their samplers and pdfs side by side, one file per light type, behind
+//! one [`Light`] interface; a [`LightSet`] holds a scene's lights and picks among them with a
+//! [`LightSelector`] (pbrt-v4 keeps selection apart from the lights in the same way). Every
+//! sampler returns its pdf in solid angle at the shading point, the measure of the
 //! direct-illumination integral, or reports a delta light.
 
 pub mod directional;
@@ -7,13 +9,16 @@ pub mod environment;
 pub mod mesh;
 pub mod point;
 pub mod quad;
+pub mod selector;
 pub mod sphere;
 pub mod spot;
 
-use crate::env::EnvMethod;
+use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
 use glam::Vec3;
+use selector::{LightSelector, SELECTORS, SelectorType};
+use std::sync::{Arc, OnceLock};
 
 /// One sample of incident light at a shading point.
 #[derive(Clone, Copy, Debug)]
@@ -72,7 +77,69 @@ pub enum MeshMethod {
     SolidAngle,
 }
 
-/// The sampler used for each kind of area light.
+impl QuadMethod {
+    pub const ALL: [QuadMethod; 2] = [QuadMethod::Area, QuadMethod::SolidAngle];
+
+    /// The name part a strategy that picks this method gets (`light-quad-sa`).
+    pub fn name(self) -> &'static str {
+        match self {
+            QuadMethod::Area => "quad-area",
+            QuadMethod::SolidAngle => "quad-sa",
+        }
+    }
+
+    pub fn describe(self) -> &'static str {
+        match self {
+            QuadMethod::Area => "quads uniform by area",
+            QuadMethod::SolidAngle => {
+                "quads uniform in solid angle (spherical rectangle, Ureña et al. 2013)"
+            }
+        }
+    }
+}
+
+impl SphereMethod {
+    pub const ALL: [SphereMethod; 3] = [SphereMethod::Area, SphereMethod::Cap, SphereMethod::Cone];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SphereMethod::Area => "sphere-area",
+            SphereMethod::Cap => "sphere-cap",
+            SphereMethod::Cone => "sphere-cone",
+        }
+    }
+
+    pub fn describe(self) -> &'static str {
+        match self {
+            SphereMethod::Area => "spheres uniform by area over the whole sphere",
+            SphereMethod::Cap => "spheres uniform by area over the visible cap",
+            SphereMethod::Cone => "spheres uniform in the subtended cone",
+        }
+    }
+}
+
+impl MeshMethod {
+    pub const ALL: [MeshMethod; 2] = [MeshMethod::Area, MeshMethod::SolidAngle];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MeshMethod::Area => "mesh-area",
+            MeshMethod::SolidAngle => "mesh-sa",
+        }
+    }
+
+    pub fn describe(self) -> &'static str {
+        match self {
+            MeshMethod::Area => "mesh triangles uniform by area",
+            MeshMethod::SolidAngle => {
+                "mesh triangles uniform in solid angle (spherical triangle, Arvo 1995)"
+            }
+        }
+    }
+}
+
+/// The sampler used for each shape of area light, and how the environment is sampled (its
+/// representation is the integrand's: see [`Self::with_env_repr`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct LightMethods {
     pub quad: QuadMethod,
@@ -96,6 +163,77 @@ impl LightMethods {
         mesh: MeshMethod::SolidAngle,
         env: EnvMethod::LATLONG_CDF,
     };
+}
+
+/// One override of [`LightMethods::BASIC`]: a light-sampling variant's distinguishing part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MethodOverride {
+    Quad(QuadMethod),
+    Sphere(SphereMethod),
+    Mesh(MeshMethod),
+}
+
+impl MethodOverride {
+    /// Every single-shape override that differs from the basic method, in listing order.
+    pub fn all() -> Vec<MethodOverride> {
+        let b = LightMethods::BASIC;
+        let quads = QuadMethod::ALL
+            .into_iter()
+            .filter(|&m| m != b.quad)
+            .map(MethodOverride::Quad);
+        let spheres = SphereMethod::ALL
+            .into_iter()
+            .filter(|&m| m != b.sphere)
+            .map(MethodOverride::Sphere);
+        let meshes = MeshMethod::ALL
+            .into_iter()
+            .filter(|&m| m != b.mesh)
+            .map(MethodOverride::Mesh);
+        quads.chain(spheres).chain(meshes).collect()
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            MethodOverride::Quad(m) => m.name(),
+            MethodOverride::Sphere(m) => m.name(),
+            MethodOverride::Mesh(m) => m.name(),
+        }
+    }
+
+    pub fn describe(self) -> &'static str {
+        match self {
+            MethodOverride::Quad(m) => m.describe(),
+            MethodOverride::Sphere(m) => m.describe(),
+            MethodOverride::Mesh(m) => m.describe(),
+        }
+    }
+
+    /// The shape whose lights this override concerns.
+    pub fn shape(self) -> LightShape {
+        match self {
+            MethodOverride::Quad(_) => LightShape::Quad,
+            MethodOverride::Sphere(_) => LightShape::Sphere,
+            MethodOverride::Mesh(_) => LightShape::Mesh,
+        }
+    }
+
+    /// `methods` with this override applied.
+    pub fn apply(self, mut methods: LightMethods) -> LightMethods {
+        match self {
+            MethodOverride::Quad(m) => methods.quad = m,
+            MethodOverride::Sphere(m) => methods.sphere = m,
+            MethodOverride::Mesh(m) => methods.mesh = m,
+        }
+        methods
+    }
+}
+
+impl LightMethods {
+    /// These methods with the environment looked up and sampled in representation `repr`.
+    pub fn with_env_repr(mut self, repr: Repr) -> Self {
+        self.env.repr = repr;
+        self
+    }
 }
 
 impl LightSample {
@@ -126,108 +264,234 @@ impl LightSample {
     }
 }
 
-#[derive(Clone, Debug)]
-pub enum Light {
-    Point(point::PointLight),
-    Spot(spot::SpotLight),
-    Directional(directional::DirectionalLight),
-    Quad(quad::QuadLight),
-    Sphere(sphere::SphereLight),
-    Mesh(mesh::MeshLight),
-    Environment(environment::EnvironmentLight),
+/// What a light knows of the point it is sampled from: the position and the shading normal
+/// (flipped to the viewer's side), as pbrt-v4's `LightSampleContext`. Selectors that weigh
+/// lights by orientation use the normal; every light sampler uses `p`.
+#[derive(Clone, Copy, Debug)]
+pub struct LightCtx {
+    pub p: Vec3,
+    pub n: Vec3,
 }
 
-impl Light {
+/// The geometry a light is sampled on: which methods apply and what the lecture's strategies
+/// say about it. A new light type on an existing shape keeps the shape's samplers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum LightShape {
+    /// A point (point and spot lights): a delta light.
+    Point,
+    /// A single direction from infinitely far away (directional light): a delta light.
+    Direction,
+    Quad,
+    Sphere,
+    Mesh,
+    /// Every direction, from infinitely far away.
+    Environment,
+}
+
+impl LightShape {
+    pub fn name(self) -> &'static str {
+        match self {
+            LightShape::Point => "point",
+            LightShape::Direction => "directional",
+            LightShape::Quad => "quad",
+            LightShape::Sphere => "sphere",
+            LightShape::Mesh => "mesh",
+            LightShape::Environment => "environment",
+        }
+    }
+
+    /// Only light sampling can reach it: no sampled direction hits a point or one direction.
+    pub fn is_delta(self) -> bool {
+        matches!(self, LightShape::Point | LightShape::Direction)
+    }
+}
+
+/// Where a traced ray found a light: a point on an emitting primitive (`local` names the
+/// light's own part, e.g. a mesh triangle), or a direction for the environment.
+#[derive(Clone, Copy, Debug)]
+pub enum LightHit {
+    Surface { q: Vec3, local: u32 },
+    Direction(Vec3),
+}
+
+/// A light source: its power for selection, its samplers by method with their pdfs, and the
+/// radiance it emits. Implementations live one per file beside this one.
+pub trait Light: Send + Sync + std::fmt::Debug {
+    fn shape(&self) -> LightShape;
+
     /// Radiant power [W], luminance-weighted, for power-proportional light selection.
-    pub fn power(&self) -> f32 {
-        match self {
-            Light::Point(l) => l.power(),
-            Light::Spot(l) => l.power(),
-            Light::Directional(l) => l.power(),
-            Light::Quad(l) => l.power(),
-            Light::Sphere(l) => l.power(),
-            Light::Mesh(l) => l.power(),
-            Light::Environment(l) => l.power(),
+    fn power(&self) -> f32;
+
+    fn is_delta(&self) -> bool {
+        self.shape().is_delta()
+    }
+
+    /// A sample of this light seen from `ctx`, by the method `m` selects for its shape.
+    /// u[0..2] place the sample, u[2] is a third number for lights with parts (a mesh's
+    /// triangle); None when the sample carries no light (the back of a one-sided emitter).
+    fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample>;
+
+    /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to
+    /// `at`. 0 for delta lights: no direction found by another strategy can reach them.
+    fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32;
+
+    /// Radiance leaving part `local` of the light at a point with outward geometric normal
+    /// `n` towards direction `w` (unit, pointing away from the light). Zero for lights without
+    /// a surface.
+    fn emitted(&self, _n: Vec3, _w: Vec3, _local: u32) -> Vec3 {
+        Vec3::ZERO
+    }
+
+    /// `m` with the methods this light cannot be sampled by replaced by ones it can (a
+    /// quad that is not a rectangle has no spherical-rectangle sampler).
+    fn usable_methods(&self, m: LightMethods) -> LightMethods {
+        m
+    }
+}
+
+/// Which light (and which part of it, e.g. a mesh triangle) a primitive emits as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EmitterRef {
+    pub light: u32,
+    pub local: u32,
+}
+
+/// A scene's lights and the selectors over them (built on first use: a light BVH over a
+/// million lights is not built for a strategy that never asks for it).
+pub struct LightSet {
+    lights: Vec<Box<dyn Light>>,
+    environment: Option<(usize, Arc<Environment>)>,
+    selectors: Vec<OnceLock<Option<Box<dyn LightSelector>>>>,
+}
+
+impl std::fmt::Debug for LightSet {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LightSet")
+            .field("lights", &self.lights)
+            .finish_non_exhaustive()
+    }
+}
+
+impl LightSet {
+    /// `environment`: the index in `lights` of the environment light and its maps.
+    pub fn new(
+        lights: Vec<Box<dyn Light>>,
+        environment: Option<(usize, Arc<Environment>)>,
+    ) -> Self {
+        LightSet {
+            lights,
+            environment,
+            selectors: SELECTORS.iter().map(|_| OnceLock::new()).collect(),
         }
     }
 
-    pub fn is_delta(&self) -> bool {
-        matches!(
-            self,
-            Light::Point(_) | Light::Spot(_) | Light::Directional(_)
-        )
+    pub fn lights(&self) -> &[Box<dyn Light>] {
+        &self.lights
     }
 
-    /// A sample of this light seen from p, by the method `m` selects for its kind.
-    pub fn sample(&self, p: Vec3, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
-        let u2 = [u[0], u[1]];
-        match self {
-            Light::Point(l) => l.sample(p),
-            Light::Spot(l) => l.sample(p),
-            Light::Directional(l) => Some(l.sample()),
-            Light::Quad(l) => match m.quad {
-                QuadMethod::Area => l.sample_area(p, u2),
-                QuadMethod::SolidAngle => l.sample_solid_angle(p, u2),
-            },
-            Light::Sphere(l) => match m.sphere {
-                SphereMethod::Area => l.sample_area(p, u2),
-                SphereMethod::Cap => l.sample_cap(p, u2),
-                SphereMethod::Cone => l.sample_cone(p, u2),
-            },
-            Light::Mesh(l) => match m.mesh {
-                MeshMethod::Area => l.sample_area(p, u),
-                MeshMethod::SolidAngle => l.sample_solid_angle(p, u),
-            },
-            Light::Environment(l) => l.sample(u2, m.env),
+    pub fn len(&self) -> usize {
+        self.lights.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.lights.is_empty()
+    }
+
+    pub fn get(&self, i: usize) -> &dyn Light {
+        self.lights[i].as_ref()
+    }
+
+    /// True if some light has shape `shape`.
+    pub fn has(&self, shape: LightShape) -> bool {
+        self.lights.iter().any(|l| l.shape() == shape)
+    }
+
+    pub fn has_delta(&self) -> bool {
+        self.lights.iter().any(|l| l.is_delta())
+    }
+
+    /// `m` as every light of the set can use it (see [`Light::usable_methods`]); resolved
+    /// once when a strategy is bound to a scene.
+    pub fn usable_methods(&self, m: LightMethods) -> LightMethods {
+        self.lights.iter().fold(m, |m, l| l.usable_methods(m))
+    }
+
+    /// The environment light's index, if the scene has one.
+    pub fn environment_index(&self) -> Option<usize> {
+        self.environment.as_ref().map(|(i, _)| *i)
+    }
+
+    /// The environment in every representation, if the scene has one.
+    pub fn environment(&self) -> Option<&Arc<Environment>> {
+        self.environment.as_ref().map(|(_, e)| e)
+    }
+
+    /// The selector of type `kind` over these lights, built on first use; None when it
+    /// cannot select (no light with positive power).
+    pub fn selector(&self, kind: &'static SelectorType) -> Option<&dyn LightSelector> {
+        let k = SELECTORS
+            .iter()
+            .position(|s| std::ptr::eq(*s, kind))
+            .expect("selector types come from SELECTORS");
+        self.selectors[k]
+            .get_or_init(|| (kind.build)(&self.lights))
+            .as_deref()
+    }
+
+    /// Picks a light with `sel` and samples it by `m`; the returned pdf includes the
+    /// selection probability.
+    pub fn sample(
+        &self,
+        sel: &dyn LightSelector,
+        ctx: &LightCtx,
+        u_select: f32,
+        u: [f32; 3],
+        m: &LightMethods,
+    ) -> Option<(usize, LightSample)> {
+        let (i, pmf) = sel.sample(ctx, u_select)?;
+        let mut s = self.lights[i].sample(ctx, u, m)?;
+        s.pdf *= pmf;
+        Some((i, s))
+    }
+
+    /// The pdf with which [`Self::sample`] produces the direction to `at` on light `light`
+    /// (selection probability included).
+    pub fn pdf(
+        &self,
+        sel: &dyn LightSelector,
+        ctx: &LightCtx,
+        light: usize,
+        at: LightHit,
+        m: &LightMethods,
+    ) -> f32 {
+        sel.pmf(ctx, light) * self.lights[light].pdf(ctx, at, m)
+    }
+
+    /// The pdf with which [`Self::sample`] produces direction `wi` towards the environment;
+    /// 0 without one.
+    pub fn env_pdf(
+        &self,
+        sel: &dyn LightSelector,
+        ctx: &LightCtx,
+        wi: Vec3,
+        m: &LightMethods,
+    ) -> f32 {
+        match self.environment_index() {
+            Some(i) => self.pdf(sel, ctx, i, LightHit::Direction(wi), m),
+            None => 0.0,
         }
     }
 
-    /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction from p
-    /// to the point q on this light (triangle `local` for a mesh). 0 for delta lights: no
-    /// direction found by another strategy can reach them; 0 for the environment, which has
-    /// no points (its pdf is by direction: `EnvironmentLight::pdf`).
-    pub fn pdf(&self, p: Vec3, q: Vec3, local: u32, m: &LightMethods) -> f32 {
-        match self {
-            Light::Point(_) | Light::Spot(_) | Light::Directional(_) | Light::Environment(_) => 0.0,
-            Light::Quad(l) => match m.quad {
-                QuadMethod::Area => l.pdf_area(p, q),
-                QuadMethod::SolidAngle => l.pdf_solid_angle(p, q),
-            },
-            Light::Sphere(l) => match m.sphere {
-                SphereMethod::Area => l.pdf_area(p, q),
-                SphereMethod::Cap => l.pdf_cap(p, q),
-                SphereMethod::Cone => l.pdf_cone(p, q),
-            },
-            Light::Mesh(l) => match m.mesh {
-                MeshMethod::Area => l.pdf_area(p, q, local as usize),
-                MeshMethod::SolidAngle => l.pdf_solid_angle(p, q, local as usize),
-            },
+    /// Radiance the environment sends along -`dir` in representation `repr` (zero without one).
+    pub fn env_radiance(&self, repr: Repr, dir: Vec3) -> Vec3 {
+        match self.environment() {
+            Some(env) => env.radiance(repr, dir),
+            None => Vec3::ZERO,
         }
     }
 
-    /// Radiance leaving the light at a point with outward geometric normal `n` towards
-    /// direction `w` (unit, pointing away from the light): one-sided for quads and meshes,
-    /// two-sided for spheres (see docs/conventions.md).
-    pub fn emitted(&self, n: Vec3, w: Vec3) -> Vec3 {
-        match self {
-            Light::Point(_) | Light::Spot(_) | Light::Directional(_) | Light::Environment(_) => {
-                Vec3::ZERO
-            }
-            Light::Quad(l) => {
-                if n.dot(w) > 0.0 {
-                    l.radiance
-                } else {
-                    Vec3::ZERO
-                }
-            }
-            Light::Mesh(l) => {
-                if n.dot(w) > 0.0 {
-                    l.radiance
-                } else {
-                    Vec3::ZERO
-                }
-            }
-            Light::Sphere(l) => l.radiance,
-        }
+    /// Radiance emitter `e` sends from a point with outward geometric normal `ng` towards `w`.
+    pub fn emitted(&self, e: EmitterRef, ng: Vec3, w: Vec3) -> Vec3 {
+        self.lights[e.light as usize].emitted(ng, w, e.local)
     }
 }

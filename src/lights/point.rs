@@ -1,6 +1,6 @@
 //! Isotropic point light: intensity I = Φ/(4π); irradiance I·cosθ/d² (inverse-square law).
 
-use super::{LightSample, direction_to};
+use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, direction_to};
 use crate::math::luminance;
 use glam::Vec3;
 
@@ -11,13 +11,9 @@ pub struct PointLight {
 }
 
 impl PointLight {
-    pub fn power(&self) -> f32 {
-        4.0 * std::f32::consts::PI * luminance(self.intensity)
-    }
-
     /// The only direction there is. None at the light's own position, where I/d² is undefined
     /// (a measure-zero set of shading points).
-    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+    pub fn sample_from(&self, p: Vec3) -> Option<LightSample> {
         let (wi, d2) = direction_to(p, self.position)?;
         Some(LightSample {
             wi,
@@ -28,5 +24,24 @@ impl PointLight {
             pdf: 1.0,
             distant: false,
         })
+    }
+}
+
+impl Light for PointLight {
+    fn shape(&self) -> LightShape {
+        LightShape::Point
+    }
+
+    fn power(&self) -> f32 {
+        4.0 * std::f32::consts::PI * luminance(self.intensity)
+    }
+
+    fn sample(&self, ctx: &LightCtx, _u: [f32; 3], _m: &LightMethods) -> Option<LightSample> {
+        self.sample_from(ctx.p)
+    }
+
+    /// A delta light: no sampled direction reaches it.
+    fn pdf(&self, _ctx: &LightCtx, _at: LightHit, _m: &LightMethods) -> f32 {
+        0.0
     }
 }

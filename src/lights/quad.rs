@@ -2,7 +2,9 @@
 //! Area sampling: a uniform point q, pdf_A = 1/A, converted to solid angle at p by
 //! pdf_ω = pdf_A · d² / |cos θ_l| (Veach 1997, eq. 8.10).
 
-use super::{LightSample, direction_to};
+use super::{
+    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, QuadMethod, direction_to,
+};
 use crate::math::gamma;
 use crate::math::luminance;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
@@ -31,10 +33,6 @@ impl QuadLight {
             area,
             radiance,
         }
-    }
-
-    pub fn power(&self) -> f32 {
-        std::f32::consts::PI * self.area * luminance(self.radiance)
     }
 
     /// Uniform area sampling. None when p sees the back (non-emitting) side, or lies in the
@@ -131,4 +129,117 @@ impl QuadLight {
     pub fn is_rectangle(&self) -> bool {
         self.edge_u.dot(self.edge_v).abs() <= 1e-5 * self.edge_u.length() * self.edge_v.length()
     }
+}
+
+impl Light for QuadLight {
+    fn shape(&self) -> LightShape {
+        LightShape::Quad
+    }
+
+    fn power(&self) -> f32 {
+        std::f32::consts::PI * self.area * luminance(self.radiance)
+    }
+
+    fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
+        match m.quad {
+            QuadMethod::Area => self.sample_area(ctx.p, [u[0], u[1]]),
+            QuadMethod::SolidAngle => self.sample_solid_angle(ctx.p, [u[0], u[1]]),
+        }
+    }
+
+    fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {
+        let LightHit::Surface { q, .. } = at else {
+            return 0.0;
+        };
+        match m.quad {
+            QuadMethod::Area => self.pdf_area(ctx.p, q),
+            QuadMethod::SolidAngle => self.pdf_solid_angle(ctx.p, q),
+        }
+    }
+
+    fn usable_methods(&self, mut m: LightMethods) -> LightMethods {
+        if !self.is_rectangle() {
+            m.quad = QuadMethod::Area;
+        }
+        m
+    }
+
+    /// One-sided: the side of edge_u × edge_v.
+    fn emitted(&self, n: Vec3, w: Vec3, _local: u32) -> Vec3 {
+        if n.dot(w) > 0.0 {
+            self.radiance
+        } else {
+            Vec3::ZERO
+        }
+    }
+}
+
+/// χ² cases: a square of side `size` centred `dist` above the origin on +z, its emitting
+/// normal tilted by `tilt` degrees away from facing the origin, sampled by each method.
+pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
+    QuadMethod::ALL
+        .into_iter()
+        .map(|method| {
+            let name = match method {
+                QuadMethod::Area => "quad-area",
+                QuadMethod::SolidAngle => "quad-solid-angle",
+            };
+            crate::chi2::WarpEntry::new(
+                name,
+                match method {
+                    QuadMethod::Area => "quad light, uniform by area, converted to solid angle",
+                    QuadMethod::SolidAngle => "quad light, spherical rectangle (Ureña et al. 2013)",
+                },
+                &[("dist", 2.0), ("tilt", 30.0), ("size", 1.0)],
+                &[
+                    &[],
+                    &[("tilt", 0.0), ("size", 4.0), ("dist", 1.0)],
+                    &[("tilt", 85.0)],
+                    &[("size", 0.01), ("dist", 5.0)],
+                ],
+                move |p| chi2_case(p, name, method),
+            )
+        })
+        .collect()
+}
+
+fn chi2_case(
+    p: &crate::chi2::Params,
+    name: &str,
+    method: QuadMethod,
+) -> Result<crate::chi2::WarpCase, String> {
+    use crate::chi2::{cap_around, first_hit, label, light_case, param};
+    use crate::geometry::triangle::Triangle;
+    let (dist, tilt, size) = (
+        param(p, "dist"),
+        param(p, "tilt").to_radians(),
+        param(p, "size"),
+    );
+    if !(dist > 0.0 && size > 0.0 && (0.0..std::f32::consts::FRAC_PI_2).contains(&tilt)) {
+        return Err("need dist > 0, size > 0 and tilt in [0, 90)".into());
+    }
+    let center = Vec3::new(0.0, 0.0, dist);
+    let eu = Vec3::new(size, 0.0, 0.0);
+    let ev = Vec3::new(0.0, -tilt.cos(), tilt.sin()) * size; // eu × ev faces -z tilted about x
+    let corner = center - 0.5 * (eu + ev);
+    let quad = QuadLight::new(corner, eu, ev, Vec3::ONE);
+    let tris = [
+        Triangle::new(corner, corner + eu, corner + eu + ev),
+        Triangle::new(corner, corner + eu + ev, corner + ev),
+    ];
+    let chart = cap_around(
+        center,
+        &[corner, corner + eu, corner + ev, corner + eu + ev],
+    );
+    let methods = LightMethods {
+        quad: method,
+        ..LightMethods::BASIC
+    };
+    Ok(light_case(
+        label(name, p),
+        quad,
+        methods,
+        move |w| first_hit(&tris, w).map(|(q, _)| (q, 0)),
+        chart,
+    ))
 }

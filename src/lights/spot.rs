@@ -3,7 +3,7 @@
 //! outside the cone θe, Hermite smoothstep in cos θ between (pbrt-v4 `SpotLight::I`). With
 //! θs = θe the edge is hard.
 
-use super::{LightSample, direction_to};
+use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, direction_to};
 use crate::math::luminance;
 use glam::Vec3;
 
@@ -28,15 +28,7 @@ impl SpotLight {
         t * t * (3.0 - 2.0 * t)
     }
 
-    /// Φ = 2π I₀ [(1 - cos θs) + (cos θs - cos θe)/2]: the smoothstep integrates to half its
-    /// interval.
-    pub fn power(&self) -> f32 {
-        2.0 * std::f32::consts::PI
-            * ((1.0 - self.cos_falloff_start) + 0.5 * (self.cos_falloff_start - self.cos_cone))
-            * luminance(self.intensity)
-    }
-
-    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+    pub fn sample_from(&self, p: Vec3) -> Option<LightSample> {
         let (wi, d2) = direction_to(p, self.position)?;
         let falloff = self.falloff(-wi.dot(self.axis));
         if falloff == 0.0 {
@@ -51,5 +43,28 @@ impl SpotLight {
             pdf: 1.0,
             distant: false,
         })
+    }
+}
+
+impl Light for SpotLight {
+    fn shape(&self) -> LightShape {
+        LightShape::Point
+    }
+
+    /// Φ = 2π I₀ [(1 - cos θs) + (cos θs - cos θe)/2]: the smoothstep integrates to half its
+    /// interval.
+    fn power(&self) -> f32 {
+        2.0 * std::f32::consts::PI
+            * ((1.0 - self.cos_falloff_start) + 0.5 * (self.cos_falloff_start - self.cos_cone))
+            * luminance(self.intensity)
+    }
+
+    fn sample(&self, ctx: &LightCtx, _u: [f32; 3], _m: &LightMethods) -> Option<LightSample> {
+        self.sample_from(ctx.p)
+    }
+
+    /// A delta light: no sampled direction reaches it.
+    fn pdf(&self, _ctx: &LightCtx, _at: LightHit, _m: &LightMethods) -> f32 {
+        0.0
     }
 }

@@ -1,7 +1,20 @@
 //! Sample warps (pure `sample_x(u)` / `x_pdf(..)` pairs, side by side, as in pbrt-v4's
-//! `util/sampling.h`), discrete distributions and the per-pixel random streams.
+//! `util/sampling.h`), discrete distributions, and the sample generators that feed them.
 
 pub mod discrete;
+pub mod generator;
 pub mod spherical;
 pub mod stream;
 pub mod warp;
+
+pub use generator::{Dimension, Dims, Layout, SampleGenerator, SampleKey};
+
+crate::plugin::registry! {
+    /// Every sample generator, in listing order; the first is the default.
+    pub static GENERATORS: dyn SampleGenerator = [independent::INDEPENDENT];
+}
+
+/// The generator named `name`.
+pub fn generator(name: &str) -> Option<&'static dyn SampleGenerator> {
+    GENERATORS.iter().copied().find(|g| g.name() == name)
+}

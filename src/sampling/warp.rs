@@ -166,6 +166,172 @@ fn wrap_phi(phi: f32) -> f32 {
     if t < 0.0 { t + 1.0 } else { t }
 }
 
+/// The χ² cases of the warps above (and the lecture's inconsistent Phong pair, which must fail).
+pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
+    use crate::chi2::{Chart, DEFAULT_SLACK, WarpCase, WarpEntry, label, omc_z, param};
+    let hemisphere = Chart::cap(Vec3::Z, 1.0 + 1e-6);
+    let mut lecture = WarpEntry::new(
+        "phong-lecture",
+        "the lecture's pair: cos α = u^(1/(n+2)) with pdf (n+2)/2π cos^n α — inconsistent, fails",
+        &[("n", 20.0)],
+        &[&[("n", 1.0)], &[("n", 20.0)]],
+        move |p| {
+            let n = param(p, "n");
+            let pdf = move |w: Vec3| {
+                if w.z > 0.0 {
+                    (n + 2.0) / (2.0 * PI) * w.z.powf(n)
+                } else {
+                    0.0
+                }
+            };
+            Ok(WarpCase {
+                label: label("phong-lecture", p),
+                sample: Box::new(move |u| {
+                    let cos = (1.0 - u[0]).powf(1.0 / (n + 2.0));
+                    let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                    let phi = 2.0 * PI * u[1];
+                    let w = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+                    Some((w, pdf(w)))
+                }),
+                pdf: Box::new(move |w| pdf(w) as f64),
+                mismatch_slack: DEFAULT_SLACK,
+                chart: hemisphere,
+            })
+        },
+    );
+    lecture.expect_fail = true;
+    vec![
+        WarpEntry::new(
+            "uniform-hemisphere",
+            "uniform hemisphere about +z, pdf 1/2π",
+            &[],
+            &[],
+            move |p| {
+                Ok(WarpCase {
+                    label: label("uniform-hemisphere", p),
+                    sample: Box::new(|u| {
+                        Some((
+                            sample_uniform_hemisphere([u[0], u[1]]),
+                            UNIFORM_HEMISPHERE_PDF,
+                        ))
+                    }),
+                    pdf: Box::new(|w| {
+                        if w.z > 0.0 {
+                            UNIFORM_HEMISPHERE_PDF as f64
+                        } else {
+                            0.0
+                        }
+                    }),
+                    mismatch_slack: DEFAULT_SLACK,
+                    chart: hemisphere,
+                })
+            },
+        ),
+        WarpEntry::new(
+            "cosine-hemisphere",
+            "cosine-weighted hemisphere (Malley, concentric disk), pdf cos θ/π",
+            &[],
+            &[],
+            move |p| {
+                Ok(WarpCase {
+                    label: label("cosine-hemisphere", p),
+                    sample: Box::new(|u| {
+                        let w = sample_cosine_hemisphere([u[0], u[1]]);
+                        (w.z > 0.0).then(|| (w, cosine_hemisphere_pdf(w.z)))
+                    }),
+                    pdf: Box::new(|w| cosine_hemisphere_pdf(w.z) as f64),
+                    mismatch_slack: DEFAULT_SLACK,
+                    chart: hemisphere,
+                })
+            },
+        ),
+        WarpEntry::new(
+            "uniform-sphere",
+            "uniform sphere, pdf 1/4π",
+            &[],
+            &[],
+            |p| {
+                Ok(WarpCase {
+                    label: label("uniform-sphere", p),
+                    sample: Box::new(|u| {
+                        Some((sample_uniform_sphere([u[0], u[1]]), UNIFORM_SPHERE_PDF))
+                    }),
+                    pdf: Box::new(|_| UNIFORM_SPHERE_PDF as f64),
+                    mismatch_slack: DEFAULT_SLACK,
+                    chart: Chart::sphere(),
+                })
+            },
+        ),
+        WarpEntry::new(
+            "uniform-cone",
+            "uniform cone about +z with half-angle sin θmax = s, stable 1 - cos θmax",
+            &[("s", 0.5)],
+            &[
+                &[("s", 0.5)],
+                &[("s", 0.999)],
+                &[("s", 1e-2)],
+                &[("s", 1e-3)],
+            ],
+            |p| {
+                let s = param(p, "s");
+                if !(s > 0.0 && s <= 1.0) {
+                    return Err("s must be in (0, 1]".into());
+                }
+                let omc = one_minus_cos_from_sin2(s * s);
+                Ok(WarpCase {
+                    label: label("uniform-cone", p),
+                    sample: Box::new(move |u| {
+                        Some((
+                            sample_uniform_cone([u[0], u[1]], omc),
+                            uniform_cone_pdf(omc),
+                        ))
+                    }),
+                    pdf: Box::new(move |w| {
+                        if omc_z(w) <= omc {
+                            uniform_cone_pdf(omc) as f64
+                        } else {
+                            0.0
+                        }
+                    }),
+                    mismatch_slack: DEFAULT_SLACK,
+                    chart: Chart::cap(Vec3::Z, omc as f64 * 1.01),
+                })
+            },
+        ),
+        WarpEntry::new(
+            "phong-lobe",
+            "Phong lobe about +z, pdf (n+1)/2π cos^n α, cos α = u^(1/(n+1)) via expm1",
+            &[("n", 20.0)],
+            &[
+                &[("n", 0.0)],
+                &[("n", 1.0)],
+                &[("n", 20.0)],
+                &[("n", 1e3)],
+                &[("n", 1e4)],
+                &[("n", 1e5)],
+            ],
+            |p| {
+                let n = param(p, "n");
+                if n < 0.0 {
+                    return Err("n must be ≥ 0".into());
+                }
+                Ok(WarpCase {
+                    label: label("phong-lobe", p),
+                    sample: Box::new(move |u| {
+                        let w = sample_phong_lobe([u[0], u[1]], n);
+                        Some((w, phong_lobe_pdf(omc_z(w), n)))
+                    }),
+                    pdf: Box::new(move |w| phong_lobe_pdf(omc_z(w), n) as f64),
+                    mismatch_slack: DEFAULT_SLACK,
+                    // The lobe holds all but e^-40 of its mass within 1 - cos α ≤ 40/(n+1).
+                    chart: Chart::cap(Vec3::Z, (40.0 / (n as f64 + 1.0)).min(1.0 + 1e-6)),
+                })
+            },
+        ),
+        lecture,
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -2,50 +2,79 @@
 //! (pdf 1/2π), cosine hemisphere (pdf cos θ/π) and BSDF sampling (the material's lobe
 //! mixture). Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
 
-use super::{EmissionProbe, Probes, ShadingPoint, Strategy};
+use super::{EmissionProbe, Estimator, Probes, ShadingPoint, Strategy};
+use crate::bsdf::LobeSelection;
 use crate::geometry::Ray;
-use crate::math::Frame;
-use crate::prepare::PreparedScene;
-use crate::sampling::stream::SampleStream;
+use crate::prepare::SceneView;
 use crate::sampling::warp::{
     UNIFORM_HEMISPHERE_PDF, cosine_hemisphere_pdf, sample_cosine_hemisphere,
     sample_uniform_hemisphere,
 };
+use crate::sampling::{Dimension, Dims, Layout};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DirectionKind {
     UniformHemisphere,
     CosineHemisphere,
     Bsdf,
 }
 
-pub struct DirectionSampling(pub DirectionKind);
+impl DirectionKind {
+    pub const ALL: [DirectionKind; 3] = [
+        DirectionKind::UniformHemisphere,
+        DirectionKind::CosineHemisphere,
+        DirectionKind::Bsdf,
+    ];
+}
+
+/// The BSDF-sampling part of a layout: the direction in the lobe, then the lobe.
+pub const BSDF_DIMS: [Dimension; 2] = [
+    Dimension::pair("bsdf direction"),
+    Dimension::one("bsdf lobe"),
+];
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct DirectionSampling {
+    pub kind: DirectionKind,
+    /// How `bsdf` picks a lobe (unused by the hemisphere samplers).
+    pub lobes: LobeSelection,
+}
+
+impl DirectionSampling {
+    pub fn new(kind: DirectionKind) -> Self {
+        DirectionSampling {
+            kind,
+            lobes: LobeSelection::default(),
+        }
+    }
+}
 
 /// Why no direction-sampling strategy applies, if none does.
-pub fn direction_sampling_applies(scene: &PreparedScene) -> Result<(), String> {
-    if scene.lights.iter().any(|l| l.is_delta()) {
+pub fn direction_sampling_applies(scene: &SceneView) -> Result<(), String> {
+    if scene.lights.has_delta() {
         return Err(
             "the scene has a point, spot or directional light, which no sampled direction can hit"
                 .into(),
         );
     }
-    if !scene.scene.has_emitters() && !scene.scene.has_environment() {
+    if !scene.has_emitting_surface() && scene.lights.environment().is_none() {
         return Err("the scene has no emitting surface and no environment".into());
     }
     Ok(())
 }
 
 impl Strategy for DirectionSampling {
-    fn name(&self) -> &'static str {
-        match self.0 {
+    fn name(&self) -> String {
+        match self.kind {
             DirectionKind::UniformHemisphere => "uniform",
             DirectionKind::CosineHemisphere => "cosine",
             DirectionKind::Bsdf => "bsdf",
         }
+        .into()
     }
 
-    fn describe(&self) -> &'static str {
-        match self.0 {
+    fn describe(&self) -> String {
+        match self.kind {
             DirectionKind::UniformHemisphere => {
                 "uniform hemisphere directions, emission of the first hit"
             }
@@ -56,33 +85,46 @@ impl Strategy for DirectionSampling {
                 "BSDF-sampled directions (lobe chosen by coefficient), emission of the first hit"
             }
         }
+        .into()
     }
 
-    fn applies(&self, scene: &PreparedScene) -> Result<(), String> {
-        direction_sampling_applies(scene)?;
-        if self.0 == DirectionKind::Bsdf && scene.bsdfs.iter().all(|b| b.is_lambertian()) {
+    fn bind<'s>(&self, scene: SceneView<'s>) -> Result<Box<dyn Estimator + 's>, String> {
+        direction_sampling_applies(&scene)?;
+        if self.kind == DirectionKind::Bsdf
+            && scene.world.materials.iter().all(|b| b.is_cosine_sampled())
+        {
             return Err("identical to `cosine`: every material is Lambertian".into());
         }
-        Ok(())
+        Ok(Box::new(*self))
+    }
+}
+
+impl Estimator for DirectionSampling {
+    fn layout(&self) -> Layout {
+        match self.kind {
+            DirectionKind::Bsdf => Layout::of(&BSDF_DIMS),
+            _ => Layout::of(&[Dimension::pair("direction")]),
+        }
     }
 
-    fn sample(&self, _scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes {
-        let u = [rng.next_1d(), rng.next_1d(), rng.next_1d()];
-        let (wi, pdf) = match self.0 {
+    fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
+        let (wi, pdf) = match self.kind {
             DirectionKind::UniformHemisphere => (
-                Frame::from_normal(sp.n).to_world(sample_uniform_hemisphere([u[0], u[1]])),
+                sp.bsdf
+                    .frame
+                    .to_world(sample_uniform_hemisphere(u.get_2d())),
                 UNIFORM_HEMISPHERE_PDF,
             ),
             DirectionKind::CosineHemisphere => {
-                let local = sample_cosine_hemisphere([u[0], u[1]]);
+                let local = sample_cosine_hemisphere(u.get_2d());
                 (
-                    Frame::from_normal(sp.n).to_world(local),
+                    sp.bsdf.frame.to_world(local),
                     cosine_hemisphere_pdf(local.z),
                 )
             }
             DirectionKind::Bsdf => {
-                let s = sp.bsdf.sample(sp.n, sp.wo, u);
-                (s.wi, s.pdf)
+                let s = sp.bsdf.sample(u.get_3d(), self.lobes);
+                return emission_probe_with(sp, s.wi, s.f, s.pdf);
             }
         };
         emission_probe(sp, wi, pdf)
@@ -97,7 +139,16 @@ pub fn emission_probe(sp: &ShadingPoint, wi: glam::Vec3, pdf: f32) -> Probes {
     if cos <= 0.0 || pdf <= 0.0 {
         return Probes::default();
     }
-    let weight = sp.bsdf.eval(sp.n, sp.wo, wi) * (cos / pdf);
+    emission_probe_with(sp, wi, sp.bsdf.eval(wi), pdf)
+}
+
+/// As [`emission_probe`] with f(wi) already known (a BSDF sample carries it).
+pub fn emission_probe_with(sp: &ShadingPoint, wi: glam::Vec3, f: glam::Vec3, pdf: f32) -> Probes {
+    let cos = sp.n.dot(wi);
+    if cos <= 0.0 || pdf <= 0.0 {
+        return Probes::default();
+    }
+    let weight = f * (cos / pdf);
     Probes {
         shadow: None,
         emission: Some(EmissionProbe {

@@ -1,17 +1,20 @@
 //! A strategy evaluated at one given shading point, with single rays: the estimator behind the
 //! unbiasedness tests and the stress suite, where a closed form is known for one point.
 
-use super::{Probes, ShadingPoint, Strategy};
-use crate::prepare::PreparedScene;
+use super::{Estimator, Probes, ShadingPoint, Strategy};
+use crate::prepare::{PreparedScene, SceneView};
 use crate::render::{emission_contribution, escape_contribution};
-use crate::sampling::stream::{SampleStream, name_id};
+use crate::sampling::generator::MAX_DIMENSIONS;
+use crate::sampling::stream::name_id;
+use crate::sampling::{Dims, GENERATORS, SampleKey};
 use crate::stats::Welford;
 use glam::Vec3;
 
 /// The radiance one sample's probes contribute, traced one ray at a time.
 pub fn probe_radiance(
     scene: &PreparedScene,
-    strategy: &dyn Strategy,
+    view: &SceneView,
+    estimator: &dyn Estimator,
     sp: &ShadingPoint,
     probes: &Probes,
 ) -> Vec3 {
@@ -23,11 +26,47 @@ pub fn probe_radiance(
     }
     if let Some(e) = probes.emission {
         l += match scene.tracer.intersect(&e.ray) {
-            Some(hit) => emission_contribution(scene, strategy, sp, &e, &hit),
-            None => escape_contribution(scene, strategy, sp, &e),
+            Some(hit) => emission_contribution(view, estimator, sp, &e, &hit),
+            None => escape_contribution(view, estimator, sp, &e),
         };
     }
     l
+}
+
+/// Calls `each` with sample i's radiance at `sp` for i in 0..samples, each sample keyed by
+/// (seed, strategy, no pixel, i) on the default generator; Err when the strategy does not
+/// apply to the scene.
+pub fn for_each_sample(
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    sp: &ShadingPoint,
+    samples: u64,
+    seed: u64,
+    mut each: impl FnMut(Vec3),
+) -> Result<(), String> {
+    let view = scene.view(strategy.integrand());
+    let estimator = strategy.bind(view)?;
+    let dims = estimator.layout().len();
+    let id = name_id(&strategy.name());
+    let mut values = [0.0f32; MAX_DIMENSIONS];
+    for i in 0..samples {
+        let key = SampleKey {
+            seed,
+            strategy: id,
+            pixel: u64::MAX,
+            index: i,
+        };
+        GENERATORS[0].fill(key, &mut values[..dims]);
+        let probes = estimator.sample(sp, &mut Dims::new(&values[..dims]));
+        each(probe_radiance(
+            scene,
+            &view,
+            estimator.as_ref(),
+            sp,
+            &probes,
+        ));
+    }
+    Ok(())
 }
 
 /// `samples` independent estimates of the reflected direct radiance at `sp`, as per-channel
@@ -40,13 +79,11 @@ pub fn estimate_at(
     seed: u64,
 ) -> [Welford; 3] {
     let mut stats = [Welford::default(); 3];
-    let id = name_id(strategy.name());
-    for i in 0..samples {
-        let mut rng = SampleStream::new(seed, id, u64::MAX, i);
-        let l = probe_radiance(scene, strategy, sp, &strategy.sample(scene, sp, &mut rng));
+    for_each_sample(scene, strategy, sp, samples, seed, |l| {
         for (c, s) in stats.iter_mut().enumerate() {
             s.add(l[c] as f64);
         }
-    }
+    })
+    .unwrap_or_else(|why| panic!("strategy `{}` does not apply: {why}", strategy.name()));
     stats
 }

@@ -1,24 +1,35 @@
 //! Multiple importance sampling (Veach & Guibas 1995) of one light sample and one BSDF sample,
 //! with the balance or power (β = 2) heuristic. Lights are sampled in solid angle where the
-//! scene allows it; the environment by the representation and sampler the strategy names,
-//! and BSDF samples that escape see the environment in that same representation. The light
-//! pdf includes the light-selection pmf (redner #56).
+//! scene allows it; the environment by the representation and sampler the strategy pins, and
+//! BSDF samples that escape see the environment in that same representation. The light pdf
+//! includes the light-selection pmf (redner #56).
 
-use super::direction::emission_probe;
-use super::light_sampling::light_probe;
-use super::{EmissionProbe, Integrand, Probes, ShadingPoint, Strategy};
-use crate::env::{EnvMethod, Repr};
-use crate::lights::LightMethods;
-use crate::prepare::{PreparedScene, SurfaceHit};
-use crate::sampling::stream::SampleStream;
+use super::direction::{BSDF_DIMS, emission_probe_with};
+use super::light_sampling::{BoundLights, LIGHT_DIMS};
+use super::{EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, Strategy, env_method_name};
+use crate::bsdf::LobeSelection;
+use crate::env::EnvMethod;
+use crate::lights::selector::{SelectorType, default_selector};
+use crate::lights::{LightMethods, LightShape};
+use crate::prepare::{SceneView, SurfaceHit};
+use crate::sampling::{Dims, Layout};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Heuristic {
     Balance,
     Power,
 }
 
 impl Heuristic {
+    pub const ALL: [Heuristic; 2] = [Heuristic::Balance, Heuristic::Power];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Heuristic::Balance => "balance",
+            Heuristic::Power => "power",
+        }
+    }
+
     /// Weight of a sample drawn with pdf `a` when the other strategy has pdf `b` (a > 0).
     /// In ratio form, so huge pdfs (tiny lights) cannot overflow.
     pub fn weight(&self, a: f32, b: f32) -> f32 {
@@ -30,128 +41,129 @@ impl Heuristic {
     }
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Mis {
-    name: &'static str,
-    describe: &'static str,
     pub heuristic: Heuristic,
-    pub env: EnvMethod,
-    /// An environment variant: applies only to scenes with an environment.
-    env_variant: bool,
+    /// The environment representation and sampler this variant pins; None: lat/long by CDF.
+    pub env: Option<EnvMethod>,
+    pub selector: &'static SelectorType,
+    pub lobes: LobeSelection,
 }
 
 impl Mis {
-    /// `mis-balance` / `mis-power`: the environment, if any, by lat/long CDF.
+    /// `mis-balance` / `mis-power`.
     pub fn new(heuristic: Heuristic) -> Self {
-        let (name, describe) = match heuristic {
-            Heuristic::Balance => (
-                "mis-balance",
-                "one light sample (solid angle) + one BSDF sample, balance heuristic",
-            ),
-            Heuristic::Power => (
-                "mis-power",
-                "one light sample (solid angle) + one BSDF sample, power heuristic",
-            ),
-        };
         Mis {
-            name,
-            describe,
             heuristic,
-            env: EnvMethod::LATLONG_CDF,
-            env_variant: false,
+            env: None,
+            selector: default_selector(),
+            lobes: LobeSelection::default(),
         }
     }
 
     /// Power heuristic with the environment in representation and sampler `env`.
-    pub fn env(name: &'static str, env: EnvMethod) -> Self {
+    pub fn env(env: EnvMethod) -> Self {
         Mis {
-            name,
-            describe: "as `mis-power`, with the environment looked up and sampled in this representation by this sampler",
-            heuristic: Heuristic::Power,
-            env,
-            env_variant: true,
+            env: Some(env),
+            ..Self::new(Heuristic::Power)
         }
     }
 
-    fn methods(&self, scene: &PreparedScene) -> LightMethods {
+    fn methods(&self) -> LightMethods {
         LightMethods {
-            env: self.env,
-            ..scene.usable_methods(LightMethods::SOLID_ANGLE)
+            env: self.env.unwrap_or(EnvMethod::LATLONG_CDF),
+            ..LightMethods::SOLID_ANGLE
         }
     }
 }
 
 impl Strategy for Mis {
-    fn name(&self) -> &'static str {
-        self.name
-    }
-
-    fn describe(&self) -> &'static str {
-        self.describe
-    }
-
-    fn applies(&self, scene: &PreparedScene) -> Result<(), String> {
-        if scene.light_selection.is_none() {
-            return Err("no light with positive power".into());
+    fn name(&self) -> String {
+        match (self.env, self.heuristic) {
+            (Some(e), Heuristic::Power) => format!("mis-env-{}", env_method_name(e)),
+            (Some(e), h) => format!("mis-{}-env-{}", h.name(), env_method_name(e)),
+            (None, h) => format!("mis-{}", h.name()),
         }
-        if !scene.scene.has_emitters() && !scene.scene.has_environment() {
+    }
+
+    fn describe(&self) -> String {
+        match self.env {
+            Some(_) => "as `mis-power`, with the environment looked up and sampled in this representation by this sampler".into(),
+            None => format!(
+                "one light sample (solid angle) + one BSDF sample, {} heuristic",
+                self.heuristic.name()
+            ),
+        }
+    }
+
+    fn integrand(&self) -> Integrand {
+        self.env
+            .map_or(Integrand::DIRECT, |e| Integrand::Direct(e.repr))
+    }
+
+    fn bind<'s>(&self, scene: SceneView<'s>) -> Result<Box<dyn Estimator + 's>, String> {
+        let lights = BoundLights::bind(&scene, self.selector, self.methods())?;
+        let has_env = scene.lights.environment().is_some();
+        if !scene.has_emitting_surface() && !has_env {
             return Err(
                 "no emitting surface and no environment: MIS would reduce to light sampling".into(),
             );
         }
-        if self.env_variant {
-            if scene.environment.is_none() {
-                return Err("the scene has no environment".into());
+        match self.env {
+            Some(_) if !has_env => return Err("the scene has no environment".into()),
+            None if self.heuristic == Heuristic::Power
+                && scene.lights.len() == 1
+                && scene.lights.has(LightShape::Environment) =>
+            {
+                return Err(
+                    "identical to `mis-env-latlong-cdf`: the environment is the only light".into(),
+                );
             }
-        } else if self.heuristic == Heuristic::Power
-            && scene.env_light.is_some()
-            && scene.lights.len() == 1
-        {
-            return Err(
-                "identical to `mis-env-latlong-cdf`: the environment is the only light".into(),
-            );
+            _ => {}
         }
-        Ok(())
+        Ok(Box::new(MisEstimator {
+            strategy: *self,
+            lights,
+        }))
+    }
+}
+
+struct MisEstimator<'s> {
+    strategy: Mis,
+    lights: BoundLights<'s>,
+}
+
+impl Estimator for MisEstimator<'_> {
+    fn layout(&self) -> Layout {
+        Layout::of(&LIGHT_DIMS).then(Layout::of(&BSDF_DIMS))
     }
 
-    fn integrand(&self) -> Integrand {
-        Integrand::direct_with(self.env.repr)
-    }
-
-    fn env_repr(&self) -> Repr {
-        self.env.repr
-    }
-
-    fn sample(&self, scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes {
-        let methods = self.methods(scene);
-        let shadow = light_probe(scene, sp, rng, &methods).map(|(mut probe, ls, light)| {
-            // A delta light is reachable by light sampling only: its weight is 1.
-            if !scene.lights[light].is_delta() {
-                probe.value *= self
-                    .heuristic
-                    .weight(ls.pdf, sp.bsdf.pdf(sp.n, sp.wo, ls.wi));
-            }
-            probe
-        });
-        let u = [rng.next_1d(), rng.next_1d(), rng.next_1d()];
-        let bs = sp.bsdf.sample(sp.n, sp.wo, u);
-        let emission = emission_probe(sp, bs.wi, bs.pdf).emission;
+    fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
+        let h = self.strategy.heuristic;
+        let lobes = self.strategy.lobes;
+        let shadow = self
+            .lights
+            .probe(sp, u)
+            .map(|(mut probe, ls, local, light)| {
+                // A delta light is reachable by light sampling only: its weight is 1.
+                if !self.lights.lights.get(light).is_delta() {
+                    probe.value *= h.weight(ls.pdf, sp.bsdf.pdf_local(local, lobes));
+                }
+                probe
+            });
+        let bs = sp.bsdf.sample(u.get_3d(), lobes);
+        let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
         Probes { shadow, emission }
     }
 
-    fn emission_weight(
-        &self,
-        scene: &PreparedScene,
-        sp: &ShadingPoint,
-        probe: &EmissionProbe,
-        hit: &SurfaceHit,
-    ) -> f32 {
+    fn emission_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe, hit: &SurfaceHit) -> f32 {
         let Some(e) = hit.emitter else { return 1.0 };
-        let p_light = scene.light_pdf(sp.p, hit.p, e, &self.methods(scene));
-        self.heuristic.weight(probe.pdf, p_light)
+        let p_light = self.lights.pdf(sp, e.light as usize, hit.p, e.local);
+        self.strategy.heuristic.weight(probe.pdf, p_light)
     }
 
-    fn env_weight(&self, scene: &PreparedScene, _sp: &ShadingPoint, probe: &EmissionProbe) -> f32 {
-        let p_light = scene.env_light_pdf(probe.ray.dir, &self.methods(scene));
-        self.heuristic.weight(probe.pdf, p_light)
+    fn env_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe) -> f32 {
+        let p_light = self.lights.env_pdf(sp, probe.ray.dir);
+        self.strategy.heuristic.weight(probe.pdf, p_light)
     }
 }

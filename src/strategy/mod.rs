@@ -1,6 +1,12 @@
-//! Direct-illumination strategies: each a named, self-contained estimator that turns a
-//! shading point into at most one shadow probe and one emission probe. The renderer traces
-//! the probes as packets; a strategy never sees the tracer.
+//! Direct-illumination strategies. A [`Strategy`] is a value composed of parts — an estimator
+//! (direction, light or MIS sampling, ambient occlusion), the light-sampling methods it
+//! overrides, the environment sampler it pins, the light selector, the lobe-selection policy —
+//! and its name is derived from those parts. Bound to a scene ([`Strategy::bind`]) it becomes
+//! an [`Estimator`], with everything that depends on the scene resolved once: the usable
+//! light methods, the selector, the environment representation of its integrand.
+//!
+//! An estimator turns a shading point into at most one shadow probe and one emission probe;
+//! the renderer traces the probes as packets. A strategy never sees the tracer.
 
 pub mod ambient_occlusion;
 pub mod direction;
@@ -8,50 +14,71 @@ pub mod estimate;
 pub mod light_sampling;
 pub mod mis;
 
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, LocalBsdf};
 use crate::env::{EnvMethod, EnvSampler, Repr};
 use crate::geometry::Ray;
-use crate::lights::{LightMethods, MeshMethod, QuadMethod, SphereMethod};
-use crate::math::offset_ray_origin;
-use crate::prepare::{PreparedScene, SurfaceHit};
-use crate::sampling::stream::SampleStream;
+use crate::lights::LightCtx;
+use crate::math::{Frame, offset_ray_origin};
+use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
+use crate::sampling::{Dims, Layout};
+use crate::tracer::LANES;
 use glam::Vec3;
 
 /// A surface point about to be shaded, with the normal flipped to the viewer's side (surfaces
 /// are two-sided reflectors) and the origin already offset for rays leaving on that side.
 #[derive(Clone, Copy, Debug)]
-pub struct ShadingPoint {
+pub struct ShadingPoint<'a> {
     pub p: Vec3,
     pub origin: Vec3,
     pub n: Vec3,
-    /// Unit direction towards the viewer.
+    /// Unit direction towards the viewer (world space).
     pub wo: Vec3,
-    pub bsdf: Bsdf,
+    /// The material in the shading frame about `n`.
+    pub bsdf: LocalBsdf<'a>,
+    /// Scan-line index of the pixel this point was seen through; `u32::MAX` for a point not
+    /// seen through the camera (a closed-form check's).
+    pub pixel: u32,
 }
 
-impl ShadingPoint {
+impl<'a> ShadingPoint<'a> {
     /// An exact point (no error to step over: rays start at `p` itself) seen along
     /// `view_dir` (unit, pointing at the surface): a point given by a test or stress case.
-    pub fn new(p: Vec3, ng: Vec3, view_dir: Vec3, bsdf: Bsdf) -> Self {
+    pub fn new(p: Vec3, ng: Vec3, view_dir: Vec3, bsdf: &'a Bsdf) -> Self {
         Self::with_error(p, Vec3::ZERO, ng, view_dir, bsdf)
     }
 
     /// A computed surface point whose coordinates are known to within `p_error` per axis.
-    pub fn with_error(p: Vec3, p_error: Vec3, ng: Vec3, view_dir: Vec3, bsdf: Bsdf) -> Self {
+    pub fn with_error(p: Vec3, p_error: Vec3, ng: Vec3, view_dir: Vec3, bsdf: &'a Bsdf) -> Self {
         let n = if ng.dot(view_dir) < 0.0 { ng } else { -ng };
+        let frame = Frame::from_normal(n);
+        let wo = -view_dir;
         ShadingPoint {
             p,
             origin: offset_ray_origin(p, p_error, n),
             n,
-            wo: -view_dir,
-            bsdf,
+            wo,
+            bsdf: LocalBsdf {
+                frame,
+                wo: frame.to_local(wo),
+                bsdf,
+            },
+            pixel: u32::MAX,
+        }
+    }
+
+    /// What a light sampler or selector is told about this point.
+    pub fn light_ctx(&self) -> LightCtx {
+        LightCtx {
+            p: self.p,
+            n: self.n,
         }
     }
 }
 
 /// What one sample asks the tracer. The contribution is `shadow.value` if the shadow segment
 /// is clear, plus `emission.weight · Le · w` for the emitter the emission ray hits first, with
-/// w the strategy's [`Strategy::emission_weight`].
+/// w the estimator's [`Estimator::emission_weight`] (or [`Estimator::env_weight`] if it
+/// escapes).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Probes {
     pub shadow: Option<ShadowProbe>,
@@ -75,60 +102,95 @@ pub struct EmissionProbe {
 /// The quantity a strategy estimates: each has its own reference image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Integrand {
-    /// Emission seen by the camera plus reflected direct illumination (an environment, if
-    /// any, in its lat/long representation).
-    Direct,
-    /// As `Direct`, with the environment resampled into another representation: a slightly
-    /// different radiance function (resampling), so it has its own reference.
-    DirectEnv(Repr),
+    /// Emission seen by the camera plus reflected direct illumination, with the environment
+    /// (if any) in this representation: resampling makes each a slightly different radiance
+    /// function, so each has its own reference.
+    Direct(Repr),
     /// (1/π)∫ V(ω) cos θ dω with occluders within the scene's AO distance.
     AmbientOcclusion,
 }
 
 impl Integrand {
+    /// Direct illumination with the environment in its source (lat/long) representation.
+    pub const DIRECT: Integrand = Integrand::Direct(Repr::LatLong);
+
+    /// Every integrand, in listing order.
+    pub const ALL: [Integrand; 5] = [
+        Integrand::Direct(Repr::LatLong),
+        Integrand::Direct(Repr::Cube),
+        Integrand::Direct(Repr::Octahedral),
+        Integrand::Direct(Repr::Healpix),
+        Integrand::AmbientOcclusion,
+    ];
+
     pub fn name(&self) -> &'static str {
         match self {
-            Integrand::Direct | Integrand::DirectEnv(Repr::LatLong) => "direct",
-            Integrand::DirectEnv(Repr::Cube) => "direct-cube",
-            Integrand::DirectEnv(Repr::Octahedral) => "direct-octa",
-            Integrand::DirectEnv(Repr::Healpix) => "direct-healpix",
+            Integrand::Direct(Repr::LatLong) => "direct",
+            Integrand::Direct(Repr::Cube) => "direct-cube",
+            Integrand::Direct(Repr::Octahedral) => "direct-octa",
+            Integrand::Direct(Repr::Healpix) => "direct-healpix",
             Integrand::AmbientOcclusion => "ao",
-        }
-    }
-
-    /// Direct illumination with the environment in representation `r`.
-    pub fn direct_with(r: Repr) -> Self {
-        match r {
-            Repr::LatLong => Integrand::Direct,
-            r => Integrand::DirectEnv(r),
         }
     }
 
     /// Emission seen by the camera counts (every integrand but AO).
     pub fn is_direct(&self) -> bool {
-        !matches!(self, Integrand::AmbientOcclusion)
+        matches!(self, Integrand::Direct(_))
+    }
+
+    /// The representation this integrand looks the environment up in.
+    pub fn env_repr(&self) -> Repr {
+        match self {
+            Integrand::Direct(r) => *r,
+            Integrand::AmbientOcclusion => Repr::LatLong,
+        }
     }
 }
 
+/// A strategy as listed, named and compared. See the module documentation.
 pub trait Strategy: Send + Sync {
-    fn name(&self) -> &'static str;
+    /// The name results are reported under, derived from the strategy's parts; it also keys
+    /// the random streams, so two strategies never share samples.
+    fn name(&self) -> String;
 
     /// One-line description for listings.
-    fn describe(&self) -> &'static str;
-
-    /// Ok if the strategy is unbiased for this scene and adds something, otherwise why not.
-    fn applies(&self, scene: &PreparedScene) -> Result<(), String>;
-
-    fn sample(&self, scene: &PreparedScene, sp: &ShadingPoint, rng: &mut SampleStream) -> Probes;
+    fn describe(&self) -> String;
 
     fn integrand(&self) -> Integrand {
-        Integrand::Direct
+        Integrand::DIRECT
     }
 
-    /// Weight of the emission an emission probe found at `hit` (MIS strategies override).
+    /// The estimator for `scene` (the view of this strategy's integrand), or why the strategy
+    /// does not apply: it would be biased there, or identical to another strategy.
+    fn bind<'s>(&self, scene: SceneView<'s>) -> Result<Box<dyn Estimator + 's>, String>;
+}
+
+/// A strategy bound to a scene.
+pub trait Estimator: Send + Sync {
+    /// Which sample dimension feeds what, in the order [`Self::sample`] reads them (after the
+    /// camera's two). A sample generator may stratify the pairs it names.
+    fn layout(&self) -> Layout;
+
+    fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes;
+
+    /// The probes of a 16-lane packet of shading points (None: the lane has no point). The
+    /// default shades lane by lane; an estimator written over lanes overrides it.
+    fn sample_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        u: &mut [Dims; LANES],
+        out: &mut [Probes; LANES],
+    ) {
+        for ((p, u), o) in points.iter().zip(u.iter_mut()).zip(out.iter_mut()) {
+            if let Some(sp) = p {
+                *o = self.sample(sp, u);
+            }
+        }
+    }
+
+    /// Weight of the emission an emission probe found at `hit` (MIS overrides).
     fn emission_weight(
         &self,
-        _scene: &PreparedScene,
         _sp: &ShadingPoint,
         _probe: &EmissionProbe,
         _hit: &SurfaceHit,
@@ -136,155 +198,28 @@ pub trait Strategy: Send + Sync {
         1.0
     }
 
-    /// The representation this strategy looks the environment up in (escaped rays, camera
-    /// rays that miss), so that its lookups and its samplers agree.
-    fn env_repr(&self) -> Repr {
-        Repr::LatLong
-    }
-
     /// Weight of environment radiance found by an emission probe that escaped (MIS overrides).
-    fn env_weight(
-        &self,
-        _scene: &PreparedScene,
-        _sp: &ShadingPoint,
-        _probe: &EmissionProbe,
-    ) -> f32 {
+    fn env_weight(&self, _sp: &ShadingPoint, _probe: &EmissionProbe) -> f32 {
         1.0
     }
-}
 
-/// Names of the environment strategies per (representation, sampler), in `Repr::ALL` and
-/// `EnvSampler::ALL` order: light sampling alone, and MIS with BSDF sampling.
-const ENV_LIGHT_NAMES: [[&str; 2]; 4] = [
-    ["env-latlong-cdf", "env-latlong-hier"],
-    ["env-cube-cdf", "env-cube-hier"],
-    ["env-octa-cdf", "env-octa-hier"],
-    ["env-healpix-cdf", "env-healpix-hier"],
-];
-const ENV_MIS_NAMES: [[&str; 2]; 4] = [
-    ["mis-env-latlong-cdf", "mis-env-latlong-hier"],
-    ["mis-env-cube-cdf", "mis-env-cube-hier"],
-    ["mis-env-octa-cdf", "mis-env-octa-hier"],
-    ["mis-env-healpix-cdf", "mis-env-healpix-hier"],
-];
-
-fn env_methods() -> impl Iterator<Item = EnvMethod> {
-    Repr::ALL.into_iter().flat_map(|repr| {
-        EnvSampler::ALL
-            .into_iter()
-            .map(move |sampler| EnvMethod { repr, sampler })
-    })
-}
-
-/// Name of the environment light-sampling strategy for `m`.
-pub fn env_light_name(m: EnvMethod) -> &'static str {
-    ENV_LIGHT_NAMES[m.repr.index()][m.sampler as usize]
-}
-
-/// Name of the environment MIS strategy for `m`.
-pub fn env_mis_name(m: EnvMethod) -> &'static str {
-    ENV_MIS_NAMES[m.repr.index()][m.sampler as usize]
-}
-
-/// Every strategy dibench knows, in listing order.
-pub fn registry() -> Vec<Box<dyn Strategy>> {
-    use direction::{DirectionKind, DirectionSampling};
-    use light_sampling::LightSampling;
-    let basic = LightMethods::BASIC;
-    let mut v: Vec<Box<dyn Strategy>> = vec![
-        Box::new(DirectionSampling(DirectionKind::UniformHemisphere)),
-        Box::new(DirectionSampling(DirectionKind::CosineHemisphere)),
-        Box::new(DirectionSampling(DirectionKind::Bsdf)),
-        Box::new(LightSampling::basic()),
-        Box::new(LightSampling::variant(
-            "light-quad-sa",
-            "as `light`, but quads uniform in solid angle (spherical rectangle, Ureña et al. 2013)",
-            LightMethods {
-                quad: QuadMethod::SolidAngle,
-                ..basic
-            },
-        )),
-        Box::new(LightSampling::variant(
-            "light-sphere-area",
-            "as `light`, but spheres uniform by area over the whole sphere",
-            LightMethods {
-                sphere: SphereMethod::Area,
-                ..basic
-            },
-        )),
-        Box::new(LightSampling::variant(
-            "light-sphere-cap",
-            "as `light`, but spheres uniform by area over the visible cap",
-            LightMethods {
-                sphere: SphereMethod::Cap,
-                ..basic
-            },
-        )),
-        Box::new(LightSampling::variant(
-            "light-mesh-sa",
-            "as `light`, but mesh triangles uniform in solid angle (spherical triangle, Arvo 1995)",
-            LightMethods {
-                mesh: MeshMethod::SolidAngle,
-                ..basic
-            },
-        )),
-        Box::new(mis::Mis::new(mis::Heuristic::Balance)),
-        Box::new(mis::Mis::new(mis::Heuristic::Power)),
-        Box::new(ambient_occlusion::AmbientOcclusion { cosine: false }),
-        Box::new(ambient_occlusion::AmbientOcclusion { cosine: true }),
-    ];
-    for m in env_methods() {
-        v.push(Box::new(LightSampling::variant(
-            env_light_name(m),
-            "as `light`, but the environment looked up and sampled in this representation by this sampler (cdf: marginal/conditional, hier: hierarchical warping)",
-            LightMethods { env: m, ..basic },
-        )));
+    /// An image-space estimator (spatial resampling, say) needs every pixel's shading point
+    /// of a pass before it shades any: the renderer then traces the whole pass's camera rays
+    /// first and calls [`Self::begin_pass`] with them. Per-point estimators leave this false.
+    fn wants_pass_points(&self) -> bool {
+        false
     }
-    for m in env_methods() {
-        v.push(Box::new(mis::Mis::env(env_mis_name(m), m)));
-    }
-    v
+
+    /// Every pixel's shading point of the coming pass, in scan-line order (None where the
+    /// camera ray missed); called only when [`Self::wants_pass_points`] is true.
+    fn begin_pass(&mut self, _pass: &PassPoints) {}
 }
 
-pub fn by_name(name: &str) -> Option<Box<dyn Strategy>> {
-    registry().into_iter().find(|s| s.name() == name)
-}
-
-/// The strategy a reference for `integrand` is rendered with: the lowest-variance unbiased
-/// one that applies.
-pub fn reference_strategy(
-    scene: &PreparedScene,
-    integrand: Integrand,
-) -> Option<Box<dyn Strategy>> {
-    let env_mis = |repr| {
-        env_mis_name(EnvMethod {
-            repr,
-            sampler: EnvSampler::Cdf,
-        })
-    };
-    let order: Vec<&str> = match integrand {
-        Integrand::Direct => vec!["mis-power", env_mis(Repr::LatLong), "light"],
-        Integrand::DirectEnv(r) => vec![env_mis(r)],
-        Integrand::AmbientOcclusion => vec!["ao-cosine"],
-    };
-    order
-        .iter()
-        .filter_map(|n| by_name(n))
-        .find(|s| s.applies(scene).is_ok())
-}
-
-/// The integrands a scene has (the set its references are made for).
-pub fn integrands(scene: &PreparedScene) -> Vec<Integrand> {
-    [
-        Integrand::Direct,
-        Integrand::DirectEnv(Repr::Cube),
-        Integrand::DirectEnv(Repr::Octahedral),
-        Integrand::DirectEnv(Repr::Healpix),
-        Integrand::AmbientOcclusion,
-    ]
-    .into_iter()
-    .filter(|&i| reference_strategy(scene, i).is_some())
-    .collect()
+/// A pass's shading points, one per pixel in scan-line order.
+pub struct PassPoints<'a> {
+    pub width: u32,
+    pub height: u32,
+    pub points: Vec<Option<ShadingPoint<'a>>>,
 }
 
 /// A strategy left out of a run, and why.
@@ -294,18 +229,119 @@ pub struct Skipped {
     pub reason: String,
 }
 
-/// Splits the registry into the strategies that apply to the scene and the ones that do not.
-pub fn applicable(scene: &PreparedScene) -> (Vec<Box<dyn Strategy>>, Vec<Skipped>) {
+/// The environment (representation, sampler) pairs, in listing order.
+pub fn env_methods() -> impl Iterator<Item = EnvMethod> {
+    Repr::ALL.into_iter().flat_map(|repr| {
+        EnvSampler::ALL
+            .into_iter()
+            .map(move |sampler| EnvMethod { repr, sampler })
+    })
+}
+
+/// The name part of an environment method: `latlong-cdf`, `octa-hier`, ...
+pub fn env_method_name(m: EnvMethod) -> String {
+    format!("{}-{}", m.repr.name(), m.sampler.name())
+}
+
+/// Every strategy dibench knows, in listing order, built from the parts: the direction
+/// samplers, light sampling with each single-shape method override, both MIS heuristics,
+/// both AO estimators, then light sampling and MIS pinned to each environment method.
+pub fn registry() -> Vec<Box<dyn Strategy>> {
+    use direction::{DirectionKind, DirectionSampling};
+    use light_sampling::LightSampling;
+    use mis::{Heuristic, Mis};
+    let mut v: Vec<Box<dyn Strategy>> = Vec::new();
+    for k in DirectionKind::ALL {
+        v.push(Box::new(DirectionSampling::new(k)));
+    }
+    v.push(Box::new(LightSampling::basic()));
+    for o in crate::lights::MethodOverride::all() {
+        v.push(Box::new(LightSampling::with_override(o)));
+    }
+    for h in Heuristic::ALL {
+        v.push(Box::new(Mis::new(h)));
+    }
+    for cosine in [false, true] {
+        v.push(Box::new(ambient_occlusion::AmbientOcclusion { cosine }));
+    }
+    for m in env_methods() {
+        v.push(Box::new(LightSampling::env(m)));
+    }
+    for m in env_methods() {
+        v.push(Box::new(Mis::env(m)));
+    }
+    v
+}
+
+pub fn by_name(name: &str) -> Option<Box<dyn Strategy>> {
+    registry().into_iter().find(|s| s.name() == name)
+}
+
+/// True if `s` applies to `scene`.
+pub fn applies(s: &dyn Strategy, scene: &PreparedScene) -> Result<(), String> {
+    s.bind(scene.view(s.integrand())).map(|_| ())
+}
+
+/// The strategy a reference for `integrand` is rendered with: the lowest-variance unbiased
+/// one that applies.
+pub fn reference_strategy(
+    scene: &PreparedScene,
+    integrand: Integrand,
+) -> Option<Box<dyn Strategy>> {
+    use light_sampling::LightSampling;
+    use mis::{Heuristic, Mis};
+    let env_mis = |repr| {
+        Box::new(Mis::env(EnvMethod {
+            repr,
+            sampler: EnvSampler::Cdf,
+        })) as Box<dyn Strategy>
+    };
+    let order: Vec<Box<dyn Strategy>> = match integrand {
+        Integrand::Direct(Repr::LatLong) => vec![
+            Box::new(Mis::new(Heuristic::Power)),
+            env_mis(Repr::LatLong),
+            Box::new(LightSampling::basic()),
+        ],
+        Integrand::Direct(r) => vec![env_mis(r)],
+        Integrand::AmbientOcclusion => {
+            vec![Box::new(ambient_occlusion::AmbientOcclusion {
+                cosine: true,
+            })]
+        }
+    };
+    order
+        .into_iter()
+        .find(|s| applies(s.as_ref(), scene).is_ok())
+}
+
+/// The integrands a scene has (the set its references are made for).
+pub fn integrands(scene: &PreparedScene) -> Vec<Integrand> {
+    Integrand::ALL
+        .into_iter()
+        .filter(|&i| reference_strategy(scene, i).is_some())
+        .collect()
+}
+
+/// Splits `strategies` into the ones that apply to the scene and the ones that do not.
+pub fn split_applicable(
+    strategies: Vec<Box<dyn Strategy>>,
+    scene: &PreparedScene,
+) -> (Vec<Box<dyn Strategy>>, Vec<Skipped>) {
     let mut run = Vec::new();
     let mut skipped = Vec::new();
-    for s in registry() {
-        match s.applies(scene) {
+    for s in strategies {
+        match applies(s.as_ref(), scene) {
             Ok(()) => run.push(s),
             Err(reason) => skipped.push(Skipped {
-                name: s.name().to_string(),
+                name: s.name(),
                 reason,
             }),
         }
     }
     (run, skipped)
+}
+
+/// Splits the registry into the strategies that apply to the scene and the ones that do not.
+pub fn applicable(scene: &PreparedScene) -> (Vec<Box<dyn Strategy>>, Vec<Skipped>) {
+    split_applicable(registry(), scene)
 }

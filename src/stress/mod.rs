@@ -9,10 +9,9 @@ pub mod cases;
 use crate::bsdf::Bsdf;
 use crate::error::{Error, Result};
 use crate::prepare::PreparedScene;
-use crate::sampling::stream::{SampleStream, name_id};
 use crate::scene::Scene;
 use crate::stats::{Welford, z_critical};
-use crate::strategy::estimate::probe_radiance;
+use crate::strategy::estimate::for_each_sample;
 use crate::strategy::{Integrand, ShadingPoint, Strategy, applicable};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -56,13 +55,22 @@ impl ViewPoint {
         }
     }
 
-    /// The shading point, exact or found by tracing (None if the traced ray misses).
-    fn shading_point(&self, scene: &PreparedScene) -> Option<ShadingPoint> {
-        let bsdf = Bsdf::new(
+    /// The point's material.
+    pub fn bsdf(&self) -> Bsdf {
+        Bsdf::blend(
             Vec3::splat(self.kd as f32),
             Vec3::splat(self.ks as f32),
             self.exponent as f32,
-        );
+        )
+    }
+
+    /// The shading point with material `bsdf`, exact or found by tracing (None if the traced
+    /// ray misses).
+    pub fn shading_point<'a>(
+        &self,
+        scene: &PreparedScene,
+        bsdf: &'a Bsdf,
+    ) -> Option<ShadingPoint<'a>> {
         let Some(from) = self.trace_from else {
             return Some(ShadingPoint::new(
                 self.p.as_vec3(),
@@ -187,7 +195,7 @@ fn tally(
     sp: &ShadingPoint,
     n: u64,
     seed: u64,
-) -> Tally {
+) -> std::result::Result<Tally, String> {
     let mut t = Tally {
         nan: 0,
         inf: 0,
@@ -195,18 +203,15 @@ fn tally(
         nonzero: 0,
         stats: Welford::default(),
     };
-    let id = name_id(strategy.name());
-    for i in 0..n {
-        let mut rng = SampleStream::new(seed, id, u64::MAX, i);
-        let l = probe_radiance(scene, strategy, sp, &strategy.sample(scene, sp, &mut rng));
+    let tallied = for_each_sample(scene, strategy, sp, n, seed, |l| {
         let c = l.to_array();
         if c.iter().any(|x| x.is_nan()) {
             t.nan += 1;
-            continue;
+            return;
         }
         if c.iter().any(|x| x.is_infinite()) {
             t.inf += 1;
-            continue;
+            return;
         }
         if c.iter().any(|&x| x < 0.0) {
             t.negative += 1;
@@ -216,8 +221,8 @@ fn tally(
             t.nonzero += 1;
         }
         t.stats.add(x);
-    }
-    t
+    });
+    tallied.map(|()| t)
 }
 
 /// Judges one tally. `z_crit` is the per-check critical value.
@@ -331,19 +336,22 @@ pub fn run(cases: &[StressCase], samples: u64, seed: u64) -> Result<Vec<StressRo
     }
     let mut jobs = Vec::new();
     let mut points = Vec::new();
-    let mut scenes = Vec::new();
     let mut empty = Vec::new();
-    for (k, case) in cases.iter().enumerate() {
-        let scene = case.prepare()?;
-        let sp = case.point.shading_point(&scene).ok_or_else(|| {
+    let scenes = cases
+        .iter()
+        .map(StressCase::prepare)
+        .collect::<Result<Vec<_>>>()?;
+    let bsdfs: Vec<Bsdf> = cases.iter().map(|c| c.point.bsdf()).collect();
+    for (k, (case, scene)) in cases.iter().zip(&scenes).enumerate() {
+        let sp = case.point.shading_point(scene, &bsdfs[k]).ok_or_else(|| {
             Error::Usage(format!("stress case {}: the traced ray misses", case.name))
         })?;
-        let (run, skipped) = applicable(&scene);
+        let (run, skipped) = applicable(scene);
         let run: Vec<_> = run
             .into_iter()
             .filter(|s| match s.integrand() {
-                Integrand::Direct => true,
-                Integrand::DirectEnv(_) => case.every_env_representation,
+                Integrand::DIRECT => true,
+                Integrand::Direct(_) => case.every_env_representation,
                 _ => false,
             })
             .collect();
@@ -354,7 +362,6 @@ pub fn run(cases: &[StressCase], samples: u64, seed: u64) -> Result<Vec<StressRo
             jobs.push((k, s));
         }
         points.push(sp);
-        scenes.push(scene);
     }
     let checks = jobs.len().max(1) as f64;
     let per_check_alpha = 1.0 - (1.0 - FAMILY_ALPHA).powf(1.0 / checks);
@@ -365,10 +372,12 @@ pub fn run(cases: &[StressCase], samples: u64, seed: u64) -> Result<Vec<StressRo
             let case = &cases[*k];
             let sp = &points[*k];
             let expected = case.expected.as_ref().map(|f| f(sp.p.as_dvec3()));
-            let t = tally(&scenes[*k], s.as_ref(), sp, samples, seed);
-            judge(case, s.name(), &t, expected, z_crit, samples)
+            let t = tally(&scenes[*k], s.as_ref(), sp, samples, seed).map_err(|why| {
+                Error::Usage(format!("stress case {}: {}: {why}", case.name, s.name()))
+            })?;
+            Ok(judge(case, &s.name(), &t, expected, z_crit, samples))
         })
-        .collect();
+        .collect::<Result<_>>()?;
     // A case no strategy applies to tests nothing: say so, with the reasons.
     for (k, skipped) in empty {
         let case = &cases[k];

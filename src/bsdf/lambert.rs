@@ -1,0 +1,36 @@
+//! Lambertian reflection kd/π, sampled cosine-weighted (Malley's method).
+
+use super::Lobe;
+use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use glam::Vec3;
+use std::f32::consts::FRAC_1_PI;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lambert {
+    pub kd: Vec3,
+}
+
+impl Lobe for Lambert {
+    fn eval(&self, _wo: Vec3, wi: Vec3) -> Vec3 {
+        if wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        self.kd * FRAC_1_PI
+    }
+
+    fn sample(&self, _wo: Vec3, u: [f32; 2]) -> Vec3 {
+        sample_cosine_hemisphere(u)
+    }
+
+    fn pdf(&self, _wo: Vec3, wi: Vec3) -> f32 {
+        cosine_hemisphere_pdf(wi.z)
+    }
+
+    fn coefficient(&self) -> Vec3 {
+        self.kd
+    }
+
+    fn is_cosine_sampled(&self) -> bool {
+        true
+    }
+}

@@ -1,0 +1,53 @@
+//! Normalized Phong lobe ks·(n+2)/(2π)·cos^n α, α the angle between wi and the mirror direction
+//! of wo (the modified Phong BRDF of Lafortune & Willems 1994, whose directional albedo is at
+//! most ks, so kd + ks ≤ 1 conserves energy), sampled by the Phong lobe warp about the mirror
+//! direction, pdf (n+1)/(2π)·cos^n α (see docs/lecture-errata.md for the lecture's pair).
+
+use super::Lobe;
+use crate::math::Frame;
+use crate::sampling::warp::{phong_lobe_pdf, sample_phong_lobe};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Phong {
+    pub ks: Vec3,
+    pub exponent: f32,
+}
+
+/// Mirror direction of wo about the local normal +z (exact: two sign flips).
+fn reflect(wo: Vec3) -> Vec3 {
+    Vec3::new(-wo.x, -wo.y, wo.z)
+}
+
+/// 1 - cos α between two unit vectors, by the chord: exact near α = 0, where 1 - dot
+/// loses everything in f32 (a Phong lobe of exponent 1e6 lives at α ~ 1e-3).
+fn one_minus_cos(a: Vec3, b: Vec3) -> f32 {
+    0.5 * (a - b).length_squared()
+}
+
+impl Lobe for Phong {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if wi.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let omc = one_minus_cos(reflect(wo), wi);
+        if omc >= 1.0 {
+            return Vec3::ZERO;
+        }
+        let n = self.exponent;
+        self.ks * ((n + 2.0) / (2.0 * PI) * (n * (-omc).ln_1p()).exp())
+    }
+
+    fn sample(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
+        Frame::from_normal(reflect(wo)).to_world(sample_phong_lobe(u, self.exponent))
+    }
+
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        phong_lobe_pdf(one_minus_cos(reflect(wo), wi), self.exponent)
+    }
+
+    fn coefficient(&self) -> Vec3 {
+        self.ks
+    }
+}

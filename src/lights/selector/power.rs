@@ -1,0 +1,65 @@
+//! Selection in proportion to each light's (luminance) power, independent of the shading
+//! point: the classic choice (pbrt-v4 `PowerLightSampler`), exact for a point that sees every
+//! light equally and poor for many lights of which few are near.
+
+use super::{LightSelector, SelectorType};
+use crate::lights::LightCtx;
+use crate::sampling::discrete::DiscreteDistribution;
+
+pub static POWER: SelectorType = SelectorType {
+    name: "power",
+    describe: "lights chosen in proportion to their power",
+    build: |lights| {
+        let powers: Vec<f32> = lights.iter().map(|l| l.power()).collect();
+        DiscreteDistribution::new(&powers)
+            .map(|d| Box::new(PowerSelector(d)) as Box<dyn LightSelector>)
+    },
+};
+
+pub struct PowerSelector(pub DiscreteDistribution);
+
+impl LightSelector for PowerSelector {
+    fn sample(&self, _ctx: &LightCtx, u: f32) -> Option<(usize, f32)> {
+        let i = self.0.sample(u);
+        Some((i, self.0.pmf(i)))
+    }
+
+    fn pmf(&self, _ctx: &LightCtx, light: usize) -> f32 {
+        self.0.pmf(light)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lights::Light;
+    use crate::lights::point::PointLight;
+    use glam::Vec3;
+
+    /// pmf ∝ power, sums to one, and `sample` reports the pmf of what it returns.
+    #[test]
+    fn proportional_to_power() {
+        let lights: Vec<Box<dyn Light>> = [1.0f32, 3.0, 0.0, 4.0]
+            .iter()
+            .map(|&i| {
+                Box::new(PointLight {
+                    position: Vec3::ZERO,
+                    intensity: Vec3::splat(i),
+                }) as Box<dyn Light>
+            })
+            .collect();
+        let s = (POWER.build)(&lights).unwrap();
+        let ctx = LightCtx {
+            p: Vec3::ONE,
+            n: Vec3::Y,
+        };
+        let pmfs: Vec<f32> = (0..4).map(|i| s.pmf(&ctx, i)).collect();
+        assert!((pmfs.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        assert!((pmfs[1] - 0.375).abs() < 1e-6 && pmfs[2] == 0.0);
+        for k in 0..100 {
+            let (i, p) = s.sample(&ctx, k as f32 / 100.0).unwrap();
+            assert_eq!(p, pmfs[i]);
+            assert_ne!(i, 2, "a light without power was picked");
+        }
+    }
+}

@@ -1,0 +1,157 @@
+//! Sample generators: where the uniform numbers of one sample come from (pbrt-v4's `Sampler`,
+//! reduced to what an equal-time harness needs). A sample is a point u ∈ [0,1)^d whose
+//! dimensions have fixed meanings: the camera's two first (the position in the pixel), then
+//! the strategy's, in the order of its [`Layout`]. A generator fills the whole point at once
+//! from its [`SampleKey`], so the renderer calls it once per pixel and pass, and a strategy reads
+//! its dimensions in order through [`Dims`].
+
+/// Every sample's identity: one generator output per (seed, strategy, pixel, sample index),
+/// so an image depends on the seed and never on thread scheduling or tile order. Pass k of a
+/// render is sample index k of each pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct SampleKey {
+    pub seed: u64,
+    /// A stable id of the strategy (`stream::name_id` of its name): two strategies never
+    /// share numbers, whatever their order in the registry.
+    pub strategy: u64,
+    /// Scan-line pixel index y·width + x; `u64::MAX` for a sample not tied to a pixel (a
+    /// single shading point, as the closed-form checks use).
+    pub pixel: u64,
+    pub index: u64,
+}
+
+/// The most dimensions one sample may have (camera included); a strategy declaring more is
+/// refused when it is bound to a scene.
+pub const MAX_DIMENSIONS: usize = 32;
+
+pub trait SampleGenerator: Send + Sync {
+    /// The name `--sampler` takes and result tables show.
+    fn name(&self) -> &'static str;
+    fn describe(&self) -> &'static str;
+    /// Writes dimensions 0..out.len() of sample `key`, each in [0, 1).
+    fn fill(&self, key: SampleKey, out: &mut [f32]);
+}
+
+/// One group of dimensions of a layout: one number, or a 2-D pair that a stratifying
+/// generator should stratify jointly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Dimension {
+    /// What the dimensions feed, for documentation and tests (e.g. "light point").
+    pub purpose: &'static str,
+    /// 1 or 2.
+    pub width: usize,
+}
+
+/// Which dimension feeds what, in the order a strategy reads them.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Layout(pub Vec<Dimension>);
+
+impl Layout {
+    /// The camera's position in the pixel: dimensions 0 and 1 of every rendered sample.
+    pub fn camera() -> Self {
+        Layout(vec![Dimension::pair("pixel position")])
+    }
+
+    pub fn of(dims: &[Dimension]) -> Self {
+        Layout(dims.to_vec())
+    }
+
+    /// This layout followed by `other`.
+    pub fn then(mut self, other: Layout) -> Self {
+        self.0.extend(other.0);
+        self
+    }
+
+    /// Number of dimensions (a pair counts two).
+    pub fn len(&self) -> usize {
+        self.0.iter().map(|d| d.width).sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// The dimension index where each group starts, with the group.
+    pub fn offsets(&self) -> impl Iterator<Item = (usize, &Dimension)> {
+        self.0.iter().scan(0, |at, d| {
+            let start = *at;
+            *at += d.width;
+            Some((start, d))
+        })
+    }
+
+    /// `purpose: a..b` for each group, for listings and errors.
+    pub fn describe(&self) -> String {
+        self.offsets()
+            .map(|(s, d)| match d.width {
+                1 => format!("{s}: {}", d.purpose),
+                w => format!("{s}..{}: {}", s + w, d.purpose),
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+impl Dimension {
+    pub const fn one(purpose: &'static str) -> Self {
+        Dimension { purpose, width: 1 }
+    }
+
+    pub const fn pair(purpose: &'static str) -> Self {
+        Dimension { purpose, width: 2 }
+    }
+}
+
+/// One sample's dimensions, read in layout order. Reading past the end is a strategy whose
+/// `layout()` undercounts what it draws: a programming error, reported by name.
+#[derive(Debug)]
+pub struct Dims<'a> {
+    values: &'a [f32],
+    next: usize,
+}
+
+impl<'a> Dims<'a> {
+    pub fn new(values: &'a [f32]) -> Self {
+        Dims { values, next: 0 }
+    }
+
+    /// The next `N` dimensions (one bounds check for all of them).
+    pub fn get<const N: usize>(&mut self) -> [f32; N] {
+        let Some(v) = self
+            .values
+            .get(self.next..self.next + N)
+            .and_then(|s| <[f32; N]>::try_from(s).ok())
+        else {
+            panic!(
+                "a strategy read dimensions {}..{} of a sample laid out with {}: its layout() must declare every dimension it draws",
+                self.next,
+                self.next + N,
+                self.values.len()
+            );
+        };
+        self.next += N;
+        v
+    }
+
+    pub fn get_1d(&mut self) -> f32 {
+        self.get::<1>()[0]
+    }
+
+    pub fn get_2d(&mut self) -> [f32; 2] {
+        self.get()
+    }
+
+    pub fn get_3d(&mut self) -> [f32; 3] {
+        self.get()
+    }
+
+    /// How many dimensions have been read.
+    pub fn used(&self) -> usize {
+        self.next
+    }
+
+    /// The dimensions not read yet (for a strategy that hands them to a part of its own).
+    pub fn remaining(&self) -> usize {
+        self.values.len() - self.next
+    }
+}
