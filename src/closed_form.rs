@@ -1,8 +1,86 @@
 //! Closed-form irradiance for configurations the unbiasedness tests and the stress suite check
-//! estimators against. E is irradiance; a Lambertian surface of albedo ρ reflects ρE/π.
+//! estimators against (E is irradiance; a Lambertian surface of albedo ρ reflects ρE/π), and
+//! the one test every such check makes: [`PointCase`] and [`mean_test`].
 
+use crate::prepare::PreparedScene;
+use crate::stats::{Welford, z_critical};
+use crate::strategy::estimate::estimate_at;
+use crate::strategy::{ShadingPoint, Strategy};
 use glam::DVec3;
 use std::f64::consts::PI;
+
+/// A two-sided z-test of a sample mean against a closed form, with the standard error from the
+/// estimator's own sample variance.
+#[derive(Clone, Copy, Debug)]
+pub struct MeanTest {
+    pub mean: f64,
+    pub expected: f64,
+    pub std_error: f64,
+    /// None for an estimator without variance (a delta light), which has no z.
+    pub z: Option<f64>,
+    pub passed: bool,
+}
+
+/// |mean − expected| < z_crit · standard error + the f32 rounding of the estimator's own
+/// arithmetic (16 ulps of the expected value: all that is left when an estimator has no
+/// variance, e.g. a delta light or cosine sampling inside a uniform sphere).
+pub fn mean_test(st: &Welford, expected: f64, z_crit: f64) -> MeanTest {
+    let se = st.std_error();
+    let rounding = 16.0 * f32::EPSILON as f64 * expected.abs();
+    MeanTest {
+        mean: st.mean,
+        expected,
+        std_error: se,
+        z: (se > 0.0).then(|| st.z_score(expected)),
+        passed: (st.mean - expected).abs() < z_crit * se + rounding,
+    }
+}
+
+/// A shading point of a scene where the reflected radiance is known per channel.
+pub struct PointCase<'a> {
+    pub scene: &'a PreparedScene,
+    pub point: ShadingPoint<'a>,
+    pub expected: [f64; 3],
+}
+
+impl PointCase<'_> {
+    /// `samples` of `strategy` at the point, each channel z-tested at significance `alpha`;
+    /// also an error when the test is too blunt to see a relative bias of `detectable` (its
+    /// standard error is too large for the closed form), so a pass means something.
+    pub fn check(
+        &self,
+        strategy: &dyn Strategy,
+        samples: u64,
+        seed: u64,
+        alpha: f64,
+        detectable: f64,
+    ) -> Result<(), String> {
+        let name = strategy.name();
+        let stats = estimate_at(self.scene, strategy, &self.point, samples, seed);
+        let z_crit = z_critical(alpha);
+        for (c, st) in stats.iter().enumerate() {
+            let t = mean_test(st, self.expected[c], z_crit);
+            if !t.passed {
+                return Err(format!(
+                    "{name}, channel {c}: mean {:.6e} vs closed form {:.6e} (se {:.2e}, z = {:.2}, critical {z_crit:.2})",
+                    t.mean,
+                    t.expected,
+                    t.std_error,
+                    t.z.unwrap_or(f64::INFINITY)
+                ));
+            }
+            if t.std_error * z_crit >= detectable * t.expected.abs() {
+                return Err(format!(
+                    "{name}: standard error {:.2e} too large to detect a {}% bias of {:.3e}",
+                    t.std_error,
+                    detectable * 100.0,
+                    t.expected
+                ));
+            }
+        }
+        Ok(())
+    }
+}
 
 /// Irradiance at a point with unit normal `n` from a uniformly emitting sphere of radiance L
 /// (Snyder 1996; Lagarde & de Rousiers 2014, `illuminanceSphereOrDisk`), including the case of
@@ -47,6 +125,20 @@ pub fn point_irradiance(p: DVec3, n: DVec3, light: DVec3, intensity: f64) -> f64
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The z-test rejects a mean off by more than its bound and accepts one within it.
+    #[test]
+    fn mean_test_has_teeth() {
+        let mut st = Welford::default();
+        for k in 0..1000 {
+            st.add(1.0 + if k % 2 == 0 { 0.1 } else { -0.1 });
+        }
+        let crit = 3.0;
+        assert!(mean_test(&st, 1.0, crit).passed);
+        let se = st.std_error();
+        assert!(!mean_test(&st, 1.0 + 4.0 * se, crit).passed);
+        assert!(mean_test(&st, 1.0 + 2.0 * se, crit).passed);
+    }
 
     /// A small, distant quad behaves like a point source: E ≈ L·A·cos θ_l·cos θ/d².
     #[test]

@@ -53,4 +53,32 @@ mod tests {
         assert!((relmse(&a, &r) - 0.5 * 4.0 / 0.01).abs() < 1e-9);
         assert_eq!(rmse(&r, &r), 0.0);
     }
+
+    /// relMSE with reference values other than 0 and 1 (where r and r² coincide): each term is
+    /// (x − r)²/(r² + 0.01), averaged over pixels and channels.
+    #[test]
+    fn relmse_divides_by_the_squared_reference() {
+        let r = Image {
+            width: 1,
+            height: 2,
+            pixels: vec![[2.0, 0.5, 3.0], [0.25, 4.0, 1.5]],
+        };
+        let x = Image {
+            width: 1,
+            height: 2,
+            pixels: vec![[3.0, 0.0, 3.0], [0.75, 2.0, 1.0]],
+        };
+        let terms = [
+            1.0 / 4.01,
+            0.25 / 0.26,
+            0.0,
+            0.25 / (0.0625 + 0.01),
+            4.0 / 16.01,
+            0.25 / 2.26,
+        ];
+        let expected = terms.iter().sum::<f64>() / 6.0;
+        assert!((relmse(&x, &r) - expected).abs() < 1e-12 * expected);
+        let se: f64 = [1.0, 0.25, 0.0, 0.25, 4.0, 0.25].iter().sum();
+        assert!((rmse(&x, &r) - (se / 6.0).sqrt()).abs() < 1e-12);
+    }
 }

@@ -3,7 +3,7 @@
 //! at significance ALPHA; each also asserts that the test is sharp enough to see a 3 % bias.
 
 use dibench::bsdf::Bsdf;
-use dibench::closed_form::{point_irradiance, polygon_irradiance, sphere_irradiance};
+use dibench::closed_form::{PointCase, point_irradiance, polygon_irradiance, sphere_irradiance};
 use dibench::prepare::PreparedScene;
 use dibench::scene::Scene;
 use dibench::stats::z_critical;
@@ -92,28 +92,13 @@ fn check_mean(
     expected: [f64; 3],
     seed: u64,
 ) {
-    let strategy = s.name();
-    let stats = estimate_at(scene, s, &sp, SAMPLES, seed);
-    let z_crit = z_critical(ALPHA);
-    for c in 0..3 {
-        let expected = expected[c];
-        let st = &stats[c];
-        let z = st.z_score(expected);
-        // Plus the f32 rounding of the estimator's own arithmetic (a few ulps), which is all that
-        // is left when an estimator has no variance (e.g. cosine sampling inside a sphere).
-        let rounding = 16.0 * f32::EPSILON as f64 * expected.abs();
-        assert!(
-            (st.mean - expected).abs() < z_crit * st.std_error() + rounding,
-            "{strategy}, channel {c}: mean {:.6e} vs closed form {expected:.6e} (se {:.2e}, z = {z:.2}, critical {z_crit:.2})",
-            st.mean,
-            st.std_error()
-        );
-        assert!(
-            st.std_error() * z_crit < DETECTABLE_BIAS * expected,
-            "{strategy}: standard error {:.2e} too large to detect a {}% bias of {expected:.3e}",
-            st.std_error(),
-            DETECTABLE_BIAS * 100.0
-        );
+    let case = PointCase {
+        scene,
+        point: sp,
+        expected,
+    };
+    if let Err(e) = case.check(s, SAMPLES, seed, ALPHA, DETECTABLE_BIAS) {
+        panic!("{e}");
     }
 }
 

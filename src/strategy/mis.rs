@@ -167,3 +167,37 @@ impl Estimator for MisEstimator<'_> {
         self.strategy.heuristic.weight(probe.pdf, p_light)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The heuristics' weights for fixed pdfs (Veach 1997, eqs. 9.12–9.13) and the property
+    /// that makes MIS unbiased: the two techniques' weights for one direction sum to one.
+    #[test]
+    fn weights_for_fixed_pdfs_sum_to_one() {
+        for (a, b) in [(2.0f32, 0.5f32), (0.3, 7.0), (1.0, 1.0), (1e-6, 3e4)] {
+            let balance = a / (a + b);
+            let power = a * a / (a * a + b * b);
+            let bw = Heuristic::Balance.weight(a, b);
+            let pw = Heuristic::Power.weight(a, b);
+            assert!(
+                (bw - balance).abs() <= 1e-6 * balance,
+                "balance({a}, {b}) = {bw}"
+            );
+            assert!(
+                (pw - power).abs() <= 1e-6 * power.max(1e-30),
+                "power({a}, {b}) = {pw}"
+            );
+            for h in Heuristic::ALL {
+                let sum = h.weight(a, b) + h.weight(b, a);
+                assert!(
+                    (sum - 1.0).abs() < 1e-6,
+                    "{h:?}({a}, {b}): weights sum to {sum}"
+                );
+            }
+        }
+        // The two heuristics differ where they should: power favours the larger pdf more.
+        assert!(Heuristic::Power.weight(3.0, 1.0) > Heuristic::Balance.weight(3.0, 1.0));
+    }
+}

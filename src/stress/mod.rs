@@ -7,6 +7,7 @@
 pub mod cases;
 
 use crate::bsdf::Bsdf;
+use crate::closed_form::mean_test;
 use crate::error::{Error, Result};
 use crate::prepare::PreparedScene;
 use crate::scene::Scene;
@@ -300,13 +301,10 @@ fn judge(
         }
         return row;
     }
-    let z = s.z_score(expected);
-    // A deterministic estimator (a delta light) has no standard error and no z.
-    row.z = (s.std_error() > 0.0).then_some(z);
-    // Plus the f32 rounding of the estimator's own arithmetic, all that is left when an
-    // estimator has (next to) no variance.
-    let rounding = 16.0 * f32::EPSILON as f64 * expected.abs();
-    if (s.mean - expected).abs() >= z_crit * s.std_error() + rounding {
+    let test = mean_test(s, expected, z_crit);
+    row.z = test.z;
+    let z = test.z.unwrap_or(f64::INFINITY);
+    if !test.passed {
         if case.known_unresolvable.contains(&strategy) {
             row.status = Status::Unresolved;
             row.detail = format!(
