@@ -5,7 +5,7 @@ use crate::harness::{compare, crosscheck, rays, reference};
 use crate::prepare::PreparedScene;
 use crate::scene::Scene;
 use crate::simd::Isa;
-use crate::strategy;
+use crate::strategy::{self, Strategy};
 use crate::tracer::backends;
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -253,12 +253,47 @@ fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
     Ok((pool, n))
 }
 
+/// The `dibench` program with the built-in strategies and `extra` ones (a researcher's own,
+/// defined outside the crate: see `examples/custom_strategy.rs`): parses the command line,
+/// runs it, reports an error on stderr and maps it to the exit status.
+pub fn main_with(extra: Vec<Box<dyn Strategy>>) -> std::process::ExitCode {
+    use std::process::ExitCode;
+    let mut strategies = strategy::registry();
+    strategies.extend(extra);
+    match run_with(Cli::parse(), strategies) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            match e {
+                // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C.
+                Error::Interrupted(_) => ExitCode::from(130),
+                _ => ExitCode::FAILURE,
+            }
+        }
+    }
+}
+
+/// Runs a parsed command with the built-in strategies.
 pub fn run(cli: Cli) -> Result<()> {
+    run_with(cli, strategy::registry())
+}
+
+/// Runs a parsed command with `strategies` as the catalogue `compare` and `strategies` use.
+pub fn run_with(cli: Cli, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
+    let mut names = std::collections::BTreeSet::new();
+    for s in &strategies {
+        if !names.insert(s.name()) {
+            return Err(Error::Usage(format!(
+                "two strategies are named `{}`: names key results and random streams, so they must be unique",
+                s.name()
+            )));
+        }
+    }
     match cli.command {
-        Command::Compare(a) => run_compare(a),
+        Command::Compare(a) => run_compare(a, strategies),
         Command::Reference(a) => run_reference(a),
         Command::Rays(a) => run_rays(a),
-        Command::Strategies { scene } => run_strategies(scene),
+        Command::Strategies { scene } => run_strategies(scene, &strategies),
         Command::Warp(a) => run_warp(a),
         Command::Crosscheck(a) => run_crosscheck(a),
         Command::Stress(a) => run_stress(a),
@@ -429,7 +464,7 @@ fn run_reference(a: ReferenceArgs) -> Result<()> {
     Ok(())
 }
 
-fn run_compare(a: CompareArgs) -> Result<()> {
+fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
     // Ctrl-C stops between passes and keeps what is complete (see `interrupt`).
     crate::interrupt::install();
     let (pool, threads) = pool(a.common.threads)?;
@@ -446,11 +481,11 @@ fn run_compare(a: CompareArgs) -> Result<()> {
         return Err(Error::Usage("--runs must be at least 1".into()));
     }
     let scene = load_with(&a.common)?;
-    let (mut run, mut skipped) = strategy::applicable(&scene);
+    let known: Vec<String> = strategies.iter().map(|s| s.name()).collect();
+    let (mut run, mut skipped) = strategy::split_applicable(strategies, &scene);
     if let Some(wanted) = &a.strategies {
         for w in wanted {
-            if strategy::by_name(w).is_none() {
-                let known: Vec<_> = strategy::registry().iter().map(|s| s.name()).collect();
+            if !known.contains(w) {
                 return Err(Error::Usage(format!(
                     "unknown strategy `{w}` (known: {})",
                     known.join(", ")
@@ -578,9 +613,9 @@ fn isa_path(c: &Common) -> Result<String> {
     })
 }
 
-fn run_strategies(scene: Option<String>) -> Result<()> {
+fn run_strategies(scene: Option<String>, strategies: &[Box<dyn Strategy>]) -> Result<()> {
     let prepared = scene.as_deref().map(load).transpose()?;
-    for s in strategy::registry() {
+    for s in strategies {
         let status = match &prepared {
             None => String::new(),
             Some(p) => match strategy::applies(s.as_ref(), p) {

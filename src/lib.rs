@@ -20,6 +20,7 @@ pub mod metrics;
 pub mod output;
 pub mod plot;
 pub mod plugin;
+pub mod prelude;
 pub mod prepare;
 pub mod render;
 pub mod sampling;

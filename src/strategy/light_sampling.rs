@@ -197,9 +197,9 @@ impl Estimator for LightEstimator<'_> {
     }
 
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
-        Probes {
-            shadow: self.0.probe(sp, u).map(|(p, ..)| p),
-            emission: None,
+        match self.0.probe(sp, u) {
+            Some((p, ..)) => Probes::shadow(p),
+            None => Probes::default(),
         }
     }
 }

@@ -85,6 +85,16 @@ pub struct Probes {
     pub emission: Option<EmissionProbe>,
 }
 
+impl Probes {
+    /// A sample that asks only whether a shadow segment is clear.
+    pub fn shadow(probe: ShadowProbe) -> Self {
+        Probes {
+            shadow: Some(probe),
+            emission: None,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowProbe {
     pub ray: Ray,
