@@ -45,6 +45,13 @@ impl LightSampling {
         }
     }
 
+    pub fn with_selector(selector: &'static SelectorType) -> Self {
+        LightSampling {
+            selector,
+            ..Self::basic()
+        }
+    }
+
     pub fn env(m: EnvMethod) -> Self {
         LightSampling {
             env: Some(m),
@@ -136,13 +143,35 @@ impl<'s> BoundLights<'s> {
     }
 }
 
+/// A strategy's name with its light selector appended when it is not the default one:
+/// `light@bvh`, `mis-power@uniform`.
+pub fn with_selector(base: String, selector: &'static SelectorType) -> String {
+    if selector == default_selector() {
+        base
+    } else {
+        format!("{base}@{}", selector.name)
+    }
+}
+
+/// Why a strategy with a non-default selector adds nothing on this scene, if it does not.
+pub fn selector_applies(scene: &SceneView, selector: &'static SelectorType) -> Result<(), String> {
+    if selector != default_selector() && scene.lights.len() < 2 {
+        return Err(format!(
+            "identical to the `{}` selector: the scene has one light",
+            default_selector().name
+        ));
+    }
+    Ok(())
+}
+
 impl Strategy for LightSampling {
     fn name(&self) -> String {
-        match (self.env, self.method) {
+        let base = match (self.env, self.method) {
             (Some(e), _) => format!("env-{}", env_method_name(e)),
             (None, Some(o)) => format!("light-{}", o.name()),
             (None, None) => "light".into(),
-        }
+        };
+        with_selector(base, self.selector)
     }
 
     fn describe(&self) -> String {
@@ -160,6 +189,7 @@ impl Strategy for LightSampling {
 
     fn bind<'s>(&self, scene: SceneView<'s>) -> Result<Box<dyn Estimator + 's>, String> {
         let bound = BoundLights::bind(&scene, self.selector, self.methods())?;
+        selector_applies(&scene, self.selector)?;
         if let Some(o) = self.method {
             if !scene.lights.has(o.shape()) {
                 return Err(format!("no {} light", o.shape().name()));

@@ -5,7 +5,7 @@
 //! includes the light-selection pmf (redner #56).
 
 use super::direction::{BSDF_DIMS, emission_probe_with};
-use super::light_sampling::{BoundLights, LIGHT_DIMS};
+use super::light_sampling::{BoundLights, LIGHT_DIMS, selector_applies, with_selector};
 use super::{EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, Strategy, env_method_name};
 use crate::bsdf::LobeSelection;
 use crate::env::EnvMethod;
@@ -79,11 +79,12 @@ impl Mis {
 
 impl Strategy for Mis {
     fn name(&self) -> String {
-        match (self.env, self.heuristic) {
+        let base = match (self.env, self.heuristic) {
             (Some(e), Heuristic::Power) => format!("mis-env-{}", env_method_name(e)),
             (Some(e), h) => format!("mis-{}-env-{}", h.name(), env_method_name(e)),
             (None, h) => format!("mis-{}", h.name()),
-        }
+        };
+        with_selector(base, self.selector)
     }
 
     fn describe(&self) -> String {
@@ -103,6 +104,7 @@ impl Strategy for Mis {
 
     fn bind<'s>(&self, scene: SceneView<'s>) -> Result<Box<dyn Estimator + 's>, String> {
         let lights = BoundLights::bind(&scene, self.selector, self.methods())?;
+        selector_applies(&scene, self.selector)?;
         let has_env = scene.lights.environment().is_some();
         if !scene.has_emitting_surface() && !has_env {
             return Err(

@@ -280,6 +280,14 @@ pub fn registry() -> Vec<Box<dyn Strategy>> {
     for m in env_methods() {
         v.push(Box::new(Mis::env(m)));
     }
+    // Light selection as an axis: light sampling and MIS (power) with every other selector.
+    for &selector in crate::lights::selector::SELECTORS.iter().skip(1) {
+        v.push(Box::new(LightSampling::with_selector(selector)));
+        v.push(Box::new(Mis {
+            selector,
+            ..Mis::new(Heuristic::Power)
+        }));
+    }
     v
 }
 
