@@ -122,6 +122,54 @@ pub fn welch_t_test(a: &[f64], b: &[f64]) -> Option<WelchTest> {
     Some(WelchTest { t, dof, p_value })
 }
 
+/// Holm's step-down adjusted p-values (Holm 1979), in the order given: with the p-values sorted
+/// ascending, adj₍ᵢ₎ = max over j ≤ i of min(1, (m − j + 1)·p₍ⱼ₎). Rejecting every hypothesis
+/// with adjusted p ≤ α keeps the family-wise error rate at most α under any dependence.
+pub fn holm_adjust(p: &[f64]) -> Vec<f64> {
+    let m = p.len();
+    let mut order: Vec<usize> = (0..m).collect();
+    order.sort_by(|&a, &b| p[a].total_cmp(&p[b]));
+    let mut out = vec![0.0; m];
+    let mut running = 0.0f64;
+    for (rank, &i) in order.iter().enumerate() {
+        running = running.max(((m - rank) as f64 * p[i]).min(1.0));
+        out[i] = running;
+    }
+    out
+}
+
+/// A least-squares line y ≈ intercept + slope·x.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineFit {
+    pub slope: f64,
+    pub intercept: f64,
+    pub n: usize,
+}
+
+/// Ordinary least squares through (x, y); None below two distinct x.
+pub fn fit_line(x: &[f64], y: &[f64]) -> Option<LineFit> {
+    let n = x.len().min(y.len());
+    if n < 2 {
+        return None;
+    }
+    let mx = x[..n].iter().sum::<f64>() / n as f64;
+    let my = y[..n].iter().sum::<f64>() / n as f64;
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for (xi, yi) in x.iter().zip(y) {
+        sxx += (xi - mx) * (xi - mx);
+        sxy += (xi - mx) * (yi - my);
+    }
+    if sxx <= 0.0 {
+        return None;
+    }
+    let slope = sxy / sxx;
+    Some(LineFit {
+        slope,
+        intercept: my - slope * mx,
+        n,
+    })
+}
+
 /// Two-sided critical z for significance α: Φ⁻¹(1 - α/2).
 pub fn z_critical(alpha: f64) -> f64 {
     use statrs::distribution::{ContinuousCDF, Normal};
@@ -217,6 +265,28 @@ mod tests {
         assert!((w.dof - 24.99).abs() < 0.01, "{w:?}");
         assert!((w.p_value - 0.021).abs() < 0.0005, "{w:?}");
         assert!(welch_t_test(&a1, &a1[..1]).is_none());
+    }
+
+    /// Holm's adjusted p-values on a worked example: p = (0.01, 0.04, 0.03, 0.005) gives
+    /// sorted 0.005·4 = 0.02, 0.01·3 = 0.03, 0.03·2 = 0.06, max(0.06, 0.04·1) = 0.06.
+    #[test]
+    fn holm_matches_a_worked_example() {
+        let adj = holm_adjust(&[0.01, 0.04, 0.03, 0.005]);
+        let want = [0.03, 0.06, 0.06, 0.02];
+        for (a, w) in adj.iter().zip(want) {
+            assert!((a - w).abs() < 1e-12, "{adj:?}");
+        }
+        assert_eq!(holm_adjust(&[0.9, 0.8]), vec![1.0, 1.0]);
+        assert!(holm_adjust(&[]).is_empty());
+    }
+
+    #[test]
+    fn line_fit_recovers_a_line() {
+        let x = [0.0, 1.0, 2.0, 3.0, 5.0];
+        let y: Vec<f64> = x.iter().map(|x| 2.5 - 0.5 * x).collect();
+        let f = fit_line(&x, &y).unwrap();
+        assert!((f.slope + 0.5).abs() < 1e-12 && (f.intercept - 2.5).abs() < 1e-12);
+        assert!(fit_line(&[1.0, 1.0], &[0.0, 1.0]).is_none());
     }
 
     #[test]

@@ -223,8 +223,8 @@ fn render_with_embree_equals_obvhs() {
             Box::new(EmbreeTracer::build(g).unwrap())
         });
         let strategy = dibench::strategy::by_name("light").unwrap();
-        let a = crosscheck::render(&obvhs, strategy.as_ref(), 3, 2);
-        let b = crosscheck::render(&embree, strategy.as_ref(), 3, 2);
+        let a = crosscheck::render(&obvhs, strategy.as_ref(), 3, 2).unwrap();
+        let b = crosscheck::render(&embree, strategy.as_ref(), 3, 2).unwrap();
         let d = crosscheck::image_rel_rmse(&a, &b);
         assert!(d < 1e-4, "{name}: relative RMSE {d}");
     }
