@@ -2,7 +2,7 @@
 //! metadata, reference noise floor and checkpoints, plots, and errors for bad arguments.
 
 mod common;
-use common::dibench;
+use common::{dibench, stored_file};
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -192,8 +192,8 @@ fn reference_noise_floor_predicts_the_difference_of_two_references() {
             "the final save replaces the 64 and 128 spp checkpoints"
         );
         floors.push(meta["noise_floor_rmse"].as_f64().unwrap());
-        images.push(read_exr(&refdir.join("direct.exr")).unwrap());
-        assert!(refdir.join("direct.variance.exr").is_file());
+        images.push(read_exr(&stored_file(&refdir.join("direct.json"), "image")).unwrap());
+        assert!(stored_file(&refdir.join("direct.json"), "variance").is_file());
     }
     let d2: Vec<f64> = images[0]
         .pixels
@@ -378,12 +378,16 @@ fn sharded_reference_merges_to_the_single_process_one() {
     let (code, _, stderr) = dibench(&["merge", "tiny.toml", "--out", "sharded"], dir.path());
     assert_eq!(code, 0, "{stderr}");
     for name in ["direct", "ao"] {
-        let read = |root: &str, file: String| {
-            dibench::output::read_exr(&dir.path().join(root).join("tiny/reference").join(file))
-                .unwrap()
+        let read = |root: &str, role: &str| {
+            let manifest = dir
+                .path()
+                .join(root)
+                .join("tiny/reference")
+                .join(format!("{name}.json"));
+            dibench::output::read_exr(&stored_file(&manifest, role)).unwrap()
         };
-        for file in [format!("{name}.exr"), format!("{name}.variance.exr")] {
-            let (a, b) = (read("single", file.clone()), read("sharded", file.clone()));
+        for file in ["image", "variance"] {
+            let (a, b) = (read("single", file), read("sharded", file));
             assert_eq!(a.pixels.len(), b.pixels.len());
             let mut worst = 0.0f64;
             for (p, q) in a.pixels.iter().zip(&b.pixels) {
