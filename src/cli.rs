@@ -136,7 +136,7 @@ pub struct CompareArgs {
     #[command(flatten)]
     pub common: Common,
     /// Wall-clock budget per strategy, in seconds.
-    #[arg(long, default_value_t = 2.0, value_parser = parse_seconds, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 2.0, value_parser = parse_seconds, allow_hyphen_values = true)]
     pub time: f64,
     /// Samples per pixel of the reference rendered when no matching one is stored.
     #[arg(long, default_value_t = 8192, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
@@ -164,7 +164,7 @@ pub struct WarpArgs {
     #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub samples: u64,
     /// Significance level of the test.
-    #[arg(long, default_value_t = 0.01, value_parser = parse_alpha, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 0.01, value_parser = parse_alpha, allow_hyphen_values = true)]
     pub alpha: f64,
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
@@ -180,6 +180,13 @@ fn parse_param(s: &str) -> std::result::Result<(String, f64), String> {
     let v: f64 = v
         .parse()
         .map_err(|_| format!("parameter `{k}`: `{v}` is not a number"))?;
+    // The samplers compute in f32: a larger value would become infinite there.
+    if v.abs() > f32::MAX as f64 {
+        return Err(format!(
+            "parameter `{k}`: {v:e} is beyond the f32 range (±{:e}) the samplers compute in",
+            f32::MAX
+        ));
+    }
     Ok((k.to_string(), v))
 }
 
@@ -237,11 +244,11 @@ pub struct ReferenceArgs {
     #[arg(long, conflicts_with = "time", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub spp: Option<u64>,
     /// Render whole passes for this many seconds instead of a fixed spp.
-    #[arg(long, value_parser = parse_seconds, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     pub time: Option<f64>,
     /// Render only shard i of n (passes i, i+n, ... of --spp) into <out>/<scene>/reference/
     /// shards/, for a cluster job array; `dibench merge` then writes the reference.
-    #[arg(long, conflicts_with = "time")]
+    #[arg(long, conflicts_with = "time", allow_hyphen_values = true)]
     pub shard: Option<String>,
 }
 

@@ -11,9 +11,8 @@
 //!
 //! [`install`] also sets the process up so that other exits are quiet and clean: a closed
 //! stdout (`dibench warp --list | head -1`) ends the process by SIGPIPE as for any Unix filter,
-//! a file-size limit (`ulimit -f`) is an I/O error like a full disk instead of a core dump, and
-//! closed standard descriptors are reopened on /dev/null so that no file we open can land on
-//! fd 2 and receive our messages.
+//! and a file-size limit (`ulimit -f`) is an I/O error like a full disk instead of a core dump.
+//! (Closed standard descriptors are reopened on /dev/null by Rust's runtime before `main`.)
 
 use std::cell::Cell;
 use std::io::Write;
@@ -58,17 +57,11 @@ pub fn install() {
 
 #[cfg(unix)]
 fn process_hygiene() {
-    // SAFETY: plain libc calls on this process's own signal dispositions and descriptors,
-    // made before any other thread exists.
+    // SAFETY: plain libc calls on this process's own signal dispositions, made before any
+    // other thread exists.
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
         libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
-        for fd in 0..=2 {
-            if libc::fcntl(fd, libc::F_GETFD) == -1 {
-                // open() returns the lowest free descriptor: this one.
-                libc::open(c"/dev/null".as_ptr(), libc::O_RDWR);
-            }
-        }
     }
 }
 

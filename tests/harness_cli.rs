@@ -425,3 +425,63 @@ fn sharded_reference_merges_to_the_single_process_one() {
     assert_eq!(code, 1);
     assert!(stderr.contains("--shard must be i/n"), "{stderr}");
 }
+
+/// A reference interrupted early never replaces a stored one of the same scene with more
+/// samples: its checkpoints are skipped while they have fewer (a rerun after a kill used to
+/// lose the better reference).
+#[test]
+fn an_interrupted_reference_keeps_the_better_stored_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = SCENE
+        .replace("width = 16", "width = 32")
+        .replace("height = 12", "height = 32")
+        .replace("[ambient_occlusion]\ndistance = 0.5\n", "");
+    std::fs::write(dir.path().join("tiny.toml"), scene).unwrap();
+    let args = ["reference", "tiny.toml", "--threads", "1", "--out", "out"];
+    let start = std::time::Instant::now();
+    let (code, _, stderr) = dibench(&[&args[..], &["--spp", "1024"]].concat(), dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    // A third of that time: past the first checkpoints, well short of 1024 spp, on any machine.
+    let a_third = start.elapsed() / 3;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dibench"))
+        .args([&args[..], &["--spp", "100000000", "--seed", "2"]].concat())
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(a_third);
+    common::signal(child.id(), libc::SIGINT);
+    let status = child.wait().unwrap();
+    let mut stderr = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    assert_eq!(status.code(), Some(130), "{stderr}");
+    let meta: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(dir.path().join("out/tiny/reference/direct.json")).unwrap(),
+    )
+    .unwrap();
+    let stopped: u64 = stderr
+        .split("stopped at ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{stderr}"));
+    assert!(
+        stopped >= 64,
+        "stopped before the first checkpoint: {stderr}"
+    );
+    if stopped < 1024 {
+        assert_eq!(
+            (meta["seed"].as_u64(), meta["spp"].as_u64()),
+            (Some(1), Some(1024)),
+            "{stderr}"
+        );
+        assert!(stderr.contains("no checkpoint of it stored"), "{stderr}");
+    }
+}

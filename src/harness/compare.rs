@@ -72,7 +72,7 @@ struct RunMeta<'a> {
     rustc: &'a str,
     commit: &'a str,
     /// The (strategy, run) pairs whose rows are in results.csv and images written; `run_dir`
-    /// adds `status` (`running`, `complete`, `interrupted`, `failed`, `killed`), whether the
+    /// adds `status` (`running`, `complete`, `interrupted`, `failed`, `unfinished`), whether the
     /// run was interrupted, and the error that ended it.
     completed: Vec<(String, u32)>,
 }

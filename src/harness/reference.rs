@@ -9,7 +9,7 @@ use crate::error::{Error, Result};
 use crate::film::{Film, Image};
 use crate::math::mix64;
 use crate::output::store::{Locked, NewFile, Store};
-use crate::output::{decode_exr, write_exr};
+use crate::output::{decode_exr, encode_exr};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy::{Integrand, reference_strategy};
@@ -146,15 +146,14 @@ pub fn render_progressive(
         commit: COMMIT.to_string(),
     };
     let mut next_checkpoint = FIRST_CHECKPOINT_SPP;
+    let mut saved = None;
     let _polling = crate::interrupt::polling();
     loop {
         if crate::interrupt::requested() {
             bar.finish_and_clear();
-            let kept = match checkpoints {
-                Some(_) if next_checkpoint > FIRST_CHECKPOINT_SPP => {
-                    format!("; the {} spp checkpoint is stored", next_checkpoint / 2)
-                }
-                _ => "; nothing stored".to_string(),
+            let kept = match saved {
+                Some(spp) => format!("; the {spp} spp checkpoint is stored"),
+                None => "; no checkpoint of it stored".to_string(),
             };
             return Err(Error::Interrupted(format!(
                 "{} reference for `{}` stopped at {} spp{kept}",
@@ -175,12 +174,22 @@ pub fn render_progressive(
         if let Some(unit) = checkpoints
             && film.spp == next_checkpoint
         {
-            save(
-                unit,
-                &film.mean(),
-                &film.variance_of_mean(),
-                &meta_of(&film),
-            )?;
+            // A checkpoint never replaces a stored reference of this content with more
+            // samples (reruns after kills would otherwise lose it); the final save does.
+            let better_stored = unit.meta::<ReferenceMeta>()?.is_some_and(|m| {
+                m.scene_hash == scene.scene.content_hash
+                    && (m.width, m.height) == (scene.scene.width, scene.scene.height)
+                    && m.spp > film.spp
+            });
+            if !better_stored {
+                save(
+                    unit,
+                    &film.mean(),
+                    &film.variance_of_mean(),
+                    &meta_of(&film),
+                )?;
+                saved = Some(film.spp);
+            }
             next_checkpoint = next_checkpoint.saturating_mul(2);
         }
     }
@@ -206,12 +215,12 @@ pub fn save(
             NewFile {
                 role: "image",
                 ext: "exr",
-                write: Box::new(|p| write_exr(p, image)),
+                write: Box::new(|p| encode_exr(p, image, p)),
             },
             NewFile {
                 role: "variance",
                 ext: "variance.exr",
-                write: Box::new(|p| write_exr(p, variance)),
+                write: Box::new(|p| encode_exr(p, variance, p)),
             },
         ],
     )

@@ -236,8 +236,14 @@ fn load_shard(unit: &Locked) -> Result<Option<LoadedShard>> {
 /// present and agree on seed, total spp and strategy; anything else is an error naming the
 /// file. Returns the reference manifests written.
 pub fn merge(out: &Path, scene: &crate::scene::Scene) -> Result<Vec<PathBuf>> {
+    let dir = reference_dir(out, &scene.name).join("shards");
+    if !dir.is_dir() {
+        return Err(Error::Usage(format!(
+            "{}: no shards to merge",
+            dir.display()
+        )));
+    }
     let shards = store(out, &scene.name)?;
-    let dir = shards.dir().to_path_buf();
     let stems = shards.stems()?;
     let mut locks = Vec::new();
     for stem in &stems {

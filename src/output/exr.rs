@@ -7,10 +7,17 @@ use crate::film::Image as RgbImage;
 use std::io::Cursor;
 use std::path::Path;
 
-/// RGB f32 EXR, ZIP-compressed scan lines (tiled files trip up some readers, e.g. tinyexr).
+/// RGB f32 EXR, ZIP-compressed scan lines (tiled files trip up some readers, e.g. tinyexr),
+/// written atomically.
 pub fn write_exr(path: &Path, img: &RgbImage) -> Result<()> {
+    super::write_atomic(path, |tmp| encode_exr(tmp, img, path))
+}
+
+/// Writes `img` as an EXR to the file `to` directly (errors name `named`): for writers that
+/// already write to a temporary file, such as a store commit.
+pub fn encode_exr(to: &Path, img: &RgbImage, named: &Path) -> Result<()> {
     use exr::prelude::*;
-    super::write_atomic(path, |tmp| {
+    {
         let w = img.width as usize;
         let enc = Encoding {
             compression: Compression::ZIP16,
@@ -28,12 +35,12 @@ pub fn write_exr(path: &Path, img: &RgbImage) -> Result<()> {
         );
         exr::image::Image::from_layer(layer)
             .write()
-            .to_file(tmp)
+            .to_file(to)
             .map_err(|e| DibenchError::Output {
-                path: path.into(),
+                path: named.into(),
                 message: format!("cannot write EXR: {e}"),
             })
-    })
+    }
 }
 
 /// Reads the first RGB(A) layer of an EXR file (a regular file, its size and then its header

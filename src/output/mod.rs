@@ -7,14 +7,15 @@
 //! - a compare run: a directory of its own, created exclusively, whose `run.json` says how
 //!   complete it is ([`run_dir`]).
 //!
-//! Temporary files are named `.<name>.<random>.tmp`; a process killed mid-write leaves one,
-//! which readers ignore and the next writer of that store or scene directory removes.
+//! Temporary files are named `.<name>.<pid>.<random>.tmp`; a process killed mid-write leaves
+//! one, which readers ignore and the next write of the same file removes (its process is gone;
+//! in a store or a run directory, whoever holds the lock removes them all).
 
 mod exr;
 pub mod run_dir;
 pub mod store;
 
-pub use exr::{decode_exr, read_exr, write_exr};
+pub use exr::{decode_exr, encode_exr, read_exr, write_exr};
 
 use crate::error::{Error, Result};
 use serde::Serialize;
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 /// Ends the name of every temporary file dibench writes.
 pub const TEMP_SUFFIX: &str = ".tmp";
 
-/// True for the name of a temporary file (ours: `.<name>.<random>.tmp`).
+/// True for the name of a temporary file (ours: `.<name>.<pid>.<random>.tmp`).
 pub fn is_temp_name(name: &str) -> bool {
     name.starts_with('.') && name.ends_with(TEMP_SUFFIX)
 }
@@ -31,7 +32,7 @@ pub fn is_temp_name(name: &str) -> bool {
 /// A temporary file in `dir` for a file named `name`, readable as an ordinary output once
 /// renamed (mode 0666 less the umask, as `File::create` gives).
 pub(crate) fn temp_file_in(dir: &Path, name: &str) -> Result<tempfile::NamedTempFile> {
-    let prefix = format!(".{name}.");
+    let prefix = format!(".{name}.{}.", std::process::id());
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(TEMP_SUFFIX);
     #[cfg(unix)]
@@ -55,6 +56,7 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
         .file_name()
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
     crate::interrupt::critical(|| {
+        remove_dead_temps(dir, &name);
         let tmp = temp_file_in(dir, &name)?;
         let _registered = crate::interrupt::register_temp(tmp.path().to_path_buf());
         write(tmp.path())?;
@@ -170,6 +172,44 @@ pub(crate) fn remove_temps(dir: &Path, prefix: &str) {
     }
 }
 
+/// Removes the temporary files for `name` in `dir` whose process is no longer alive.
+fn remove_dead_temps(dir: &Path, name: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.");
+    for e in entries.flatten() {
+        let Ok(file) = e.file_name().into_string() else {
+            continue;
+        };
+        let Some(rest) = file.strip_prefix(&prefix).filter(|_| is_temp_name(&file)) else {
+            continue;
+        };
+        let pid = rest.split('.').next().and_then(|p| p.parse::<u32>().ok());
+        if pid.is_some_and(|p| !process_alive(p)) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Whether process `pid` exists (it may have been reused: then its temporary files stay).
+#[cfg(unix)]
+fn process_alive(pid: u32) -> bool {
+    let Ok(pid) = libc::pid_t::try_from(pid) else {
+        return true;
+    };
+    // SAFETY: signal 0 only checks that the process exists and may be signalled.
+    unsafe {
+        libc::kill(pid, 0) == 0
+            || std::io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH)
+    }
+}
+
+#[cfg(not(unix))]
+fn process_alive(_pid: u32) -> bool {
+    true
+}
+
 /// Flushes a directory's entries (the renames just made in it) to disk, where supported.
 pub(crate) fn sync_dir(dir: &Path) {
     if let Ok(d) = std::fs::File::open(dir) {
@@ -196,6 +236,23 @@ mod tests {
             .map(|e| e.file_name())
             .collect();
         assert_eq!(names, ["a.json"], "temporary files left behind");
+    }
+
+    /// A temporary file of a dead process is removed by the next write of its file; one of a
+    /// live process (this one) is not.
+    #[test]
+    fn the_next_write_removes_temporary_files_of_dead_processes() {
+        let dir = tempfile::tempdir().unwrap();
+        // Above the largest pid_max (2^22), so no such process exists.
+        let dead = dir.path().join(".a.csv.2147483000.x1.tmp");
+        let live = dir
+            .path()
+            .join(format!(".a.csv.{}.x2.tmp", std::process::id()));
+        std::fs::write(&dead, "half").unwrap();
+        std::fs::write(&live, "half").unwrap();
+        write_bytes(&dir.path().join("a.csv"), b"x").unwrap();
+        assert!(!dead.exists());
+        assert!(live.exists());
     }
 
     #[test]

@@ -1,11 +1,12 @@
 //! A compare run's own directory, `<scene dir>/<stamp>-seed<N>`: created exclusively (a run
 //! that finds the name taken, e.g. another run of the same seed started in the same second,
 //! takes `<stamp>-seed<N>-2`, `-3`, …), locked for the run's life, and with a `run.json` that
-//! always tells how complete the run is: `status` is `running` while it writes, then
-//! `complete`, `interrupted` or `failed` (with the error). A run killed outright stays
-//! `running` until the next run in the same scene directory finds its lock free and marks it
-//! `killed` (and removes its temporary files). A run that ends before anything was recorded in
-//! it removes its directory.
+//! always tells how complete the run is: `status` is `running` from the directory's creation
+//! while the run works, then `complete`, `interrupted` or `failed` (with the error). A run that
+//! ends before any result was recorded removes its directory. A run killed outright (or whose
+//! last `run.json` could not be written: a full disk) stays `running` until the next run in the
+//! same scene directory finds its lock free: that one removes its temporary files, and marks it
+//! `unfinished`, or removes it if it holds no results.
 
 use crate::error::{Error, Result};
 use serde::Serialize;
@@ -22,7 +23,8 @@ pub enum Status {
     Complete,
     Interrupted,
     Failed,
-    Killed,
+    /// Found dead by a later run: the process ended without recording how.
+    Unfinished,
 }
 
 impl Status {
@@ -32,7 +34,7 @@ impl Status {
             Status::Complete => "complete",
             Status::Interrupted => "interrupted",
             Status::Failed => "failed",
-            Status::Killed => "killed",
+            Status::Unfinished => "unfinished",
         }
     }
 }
@@ -89,6 +91,12 @@ impl RunDir {
             record: Mutex::new(None),
             keep: AtomicBool::new(false),
         });
+        // Written while locked, so that a run.json saying `running` with a free lock means a
+        // dead run (see `mark_dead_runs`).
+        if let Err(e) = shared.write(Value::Object(Default::default()), Status::Running, None) {
+            let _ = std::fs::remove_dir_all(&path);
+            return Err(e);
+        }
         let on_exit = shared.clone();
         let hook = crate::interrupt::on_exit(move || on_exit.abandon(Status::Interrupted, None));
         Ok(RunDir {
@@ -160,8 +168,9 @@ impl Shared {
     }
 }
 
-/// Marks the runs in `scene_dir` whose process died while running (`run.json` says `running`
-/// but nobody holds the lock) as `killed`, and removes their temporary files.
+/// Finds the runs in `scene_dir` whose process ended while running (`run.json` says `running`
+/// but nobody holds the lock): removes their temporary files, and marks them `unfinished`, or
+/// removes them when they hold no results.
 fn mark_dead_runs(scene_dir: &Path) {
     let Ok(entries) = std::fs::read_dir(scene_dir) else {
         return;
@@ -183,7 +192,12 @@ fn mark_dead_runs(scene_dir: &Path) {
             continue;
         };
         if value.get("status").and_then(Value::as_str) == Some(Status::Running.name()) {
-            value["status"] = Status::Killed.name().into();
+            if !dir.join("results.csv").exists() {
+                drop(lock);
+                let _ = std::fs::remove_dir_all(&dir);
+                continue;
+            }
+            value["status"] = Status::Unfinished.name().into();
             let _ = super::write_json(&json, &value);
         }
     }
@@ -224,9 +238,9 @@ mod tests {
     }
 
     /// A run whose process is gone (its lock free) but whose run.json says `running` is marked
-    /// `killed` by the next run; a live one is left alone.
+    /// `unfinished` by the next run, or removed if it has no results; a live one is left alone.
     #[test]
-    fn dead_runs_are_marked_killed_and_live_ones_are_not() {
+    fn dead_runs_are_marked_unfinished_and_live_ones_are_not() {
         let dir = tempfile::tempdir().unwrap();
         let live = RunDir::create(dir.path(), "live").unwrap();
         live.record(&serde_json::json!({}), Status::Running)
@@ -236,14 +250,20 @@ mod tests {
         File::create(dead.join(LOCK)).unwrap();
         std::fs::write(dead.join(RUN_JSON), r#"{"status": "running"}"#).unwrap();
         std::fs::write(dead.join(".results.csv.x1.tmp"), "half").unwrap();
+        std::fs::write(dead.join("results.csv"), "rows").unwrap();
+        let empty = dir.path().join("empty");
+        std::fs::create_dir(&empty).unwrap();
+        File::create(empty.join(LOCK)).unwrap();
+        std::fs::write(empty.join(RUN_JSON), r#"{"status": "running"}"#).unwrap();
         let _next = RunDir::create(dir.path(), "next").unwrap();
         let status = |d: &Path| {
             let v: Value =
                 serde_json::from_slice(&std::fs::read(d.join(RUN_JSON)).unwrap()).unwrap();
             v["status"].as_str().unwrap().to_string()
         };
-        assert_eq!(status(&dead), "killed");
+        assert_eq!(status(&dead), "unfinished");
         assert_eq!(status(live.path()), "running");
         assert!(!dead.join(".results.csv.x1.tmp").exists());
+        assert!(!empty.exists());
     }
 }

@@ -234,6 +234,11 @@ impl Locked<'_> {
         Ok(Some((m.meta, m.files)))
     }
 
+    /// The committed metadata alone (files not read nor checked); None when nothing is.
+    pub fn meta<M: DeserializeOwned>(&self) -> Result<Option<M>> {
+        Ok(self.read_manifest::<M>()?.map(|(m, _)| m))
+    }
+
     /// The unit, every file checked against its manifest; None when nothing is committed.
     pub fn read<M: DeserializeOwned>(&self) -> Result<Option<Unit<M>>> {
         let Some((meta, records)) = self.read_manifest::<M>()? else {
