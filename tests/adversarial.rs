@@ -6,7 +6,8 @@
 
 mod common;
 use common::{
-    Outcome, TINY, check_run_dir, check_store, dibench_bounded, run_dirs, stored_file, temps_under,
+    Outcome, QUICK_COMPARE, TINY, check_run_dir, check_store, dibench_bounded, run_dirs,
+    stored_file, temps_under,
 };
 
 use std::path::Path;
@@ -80,20 +81,7 @@ const SECONDS: &[&str] = &[
 #[test]
 fn compare_flags_at_their_extremes() {
     let dir = setup();
-    let base = [
-        "compare",
-        "tiny.toml",
-        "--time",
-        "0.01",
-        "--reference-spp",
-        "16",
-        "--strategies",
-        "light",
-        "--threads",
-        "1",
-        "--out",
-        "out",
-    ];
+    let base = QUICK_COMPARE;
     sweep(dir.path(), &base, "--time", SECONDS, "--time");
     sweep(dir.path(), &base, "--reference-spp", U64, "--reference-spp");
     sweep(dir.path(), &base, "--runs", U32, "--runs");
@@ -465,22 +453,24 @@ fn scene_files_every_way_broken() {
     );
     // An --out that is not UTF-8 is a fine directory name.
     let out = std::ffi::OsStr::from_bytes(b"out\xff");
-    let args: Vec<&std::ffi::OsStr> = [
-        "compare",
-        "tiny.toml",
-        "--time",
-        "0.01",
-        "--reference-spp",
-        "16",
-        "--strategies",
-        "light",
-        "--out",
-    ]
-    .iter()
-    .map(std::ffi::OsStr::new)
-    .chain([out])
-    .collect();
+    let args: Vec<&std::ffi::OsStr> = QUICK_COMPARE[..11]
+        .iter()
+        .map(std::ffi::OsStr::new)
+        .chain([out])
+        .collect();
     assert_eq!(dibench_bounded(&args, d, PATIENCE).code, Some(0));
+    // Nesting 100 000 deep (a parser's stack) and a megabyte line: refused, quoted briefly.
+    std::fs::write(
+        d.join("deep.toml"),
+        format!("x = {}{}\n", "[".repeat(100_000), "]".repeat(100_000)),
+    )
+    .unwrap();
+    let o = run(d, &["strategies", "deep.toml"]);
+    assert!(
+        o.code == Some(1) && o.stderr.contains("deep.toml") && o.stderr.len() < 2000,
+        "{}",
+        &o.stderr[..o.stderr.len().min(500)]
+    );
     // A file name that cannot name a results directory.
     std::fs::write(d.join("..toml"), TINY).unwrap();
     refused(d, "..toml", &["rename the file"]);
@@ -757,6 +747,22 @@ fn stored_references_every_way_broken() {
     std::fs::remove_file(&image).unwrap();
     std::fs::write(&image, &saved).unwrap();
     assert_eq!(compare(d).code, Some(0));
+    // A FIFO in place of the unit's lock file: refused, not an open blocked forever.
+    let lock = refs.join(".direct.lock");
+    std::fs::remove_file(&lock).unwrap();
+    assert!(
+        Command::new("mkfifo")
+            .arg(&lock)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let o = compare(d);
+    assert!(
+        o.code == Some(1) && o.stderr.contains(".direct.lock"),
+        "{o:?}"
+    );
+    std::fs::remove_file(&lock).unwrap();
     // The layout before manifests (`direct.exr` beside a JSON without `files`): not trusted,
     // rendered again, and replaced by a committed unit.
     for f in std::fs::read_dir(&refs).unwrap().flatten() {

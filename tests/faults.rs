@@ -236,6 +236,8 @@ fn sigkill_at_random_moments_leaves_consistent_output() {
     );
     // The rerun held the reference unit and looked at the scene directory: no leftovers.
     check_store(&dir.path().join("out/s/reference"), true).unwrap();
+    let left = temps_under(&dir.path().join("out"));
+    assert!(left.is_empty(), "{left:?}");
     for run in run_dirs(&dir.path().join("out/s")) {
         check_run_dir(&run, true).unwrap();
     }
@@ -589,7 +591,11 @@ fn a_full_disk_at_any_stage_is_reported_and_recorded() {
         std::fs::remove_dir_all(r).unwrap();
     }
     let (mut no_dir, mut failed_with_results, mut complete) = (0, 0, 0);
-    for limit in (1..=12).map(|k| k * 1024).chain([1 << 20]) {
+    for limit in [64, 256, 512]
+        .into_iter()
+        .chain((1..=12).map(|k| k * 1024))
+        .chain([1 << 20])
+    {
         let o = dibench_bounded_with(&args, dir.path(), PATIENT, |cmd| {
             use std::os::unix::process::CommandExt;
             // SAFETY: setrlimit in the child before exec touches only that process.

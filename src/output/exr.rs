@@ -73,9 +73,11 @@ pub fn decode_exr<T: Clone + Default + 'static>(
     let meta =
         exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(unreadable)?;
     let mut largest = 0u64;
+    let mut blocks = 0u64;
     for h in meta.headers.iter() {
         let (w, hgt) = (h.layer_size.width() as u64, h.layer_size.height() as u64);
-        if bounded::bytes(h.chunk_count as u64, 8) > bytes.len() as u64 {
+        blocks = blocks.saturating_add(h.chunk_count as u64);
+        if bounded::bytes(blocks, 8) > bytes.len() as u64 {
             return Err(DibenchError::Parse {
                 path: path.into(),
                 message: format!(

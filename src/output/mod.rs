@@ -158,6 +158,30 @@ pub fn check_output_dir(dir: &Path, named_by: &str) -> Result<()> {
         .map_err(|e| named(Error::io(dir, e)))
 }
 
+/// Opens (or with `create`, creates) the lock file `path` without blocking, refusing anything
+/// but a regular file: a FIFO put in its place would block an open for writing forever.
+pub(crate) fn open_lock(path: &Path, create: bool) -> Result<std::fs::File> {
+    let mut options = std::fs::OpenOptions::new();
+    options
+        .read(true)
+        .write(true)
+        .create(create)
+        .truncate(false);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path).map_err(|e| Error::io(path, e))?;
+    if !file.metadata().map_err(|e| Error::io(path, e))?.is_file() {
+        return Err(Error::Output {
+            path: path.into(),
+            message: "a lock file that is not a regular file: remove it".into(),
+        });
+    }
+    Ok(file)
+}
+
 /// Removes the temporary files directly in `dir` (left by killed processes; call only where no
 /// live writer can own one, i.e. holding that directory's lock).
 pub(crate) fn remove_temps(dir: &Path, prefix: &str) {
@@ -182,14 +206,21 @@ fn remove_dead_temps(dir: &Path, name: &str) {
         let Ok(file) = e.file_name().into_string() else {
             continue;
         };
-        let Some(rest) = file.strip_prefix(&prefix).filter(|_| is_temp_name(&file)) else {
-            continue;
-        };
-        let pid = rest.split('.').next().and_then(|p| p.parse::<u32>().ok());
-        if pid.is_some_and(|p| !process_alive(p)) {
+        if file.starts_with(&prefix) && is_dead_temp(&file) {
             let _ = std::fs::remove_file(e.path());
         }
     }
+}
+
+/// True for a temporary name (`.<name>.<pid>.<random>.tmp`) whose process is gone.
+pub(crate) fn is_dead_temp(name: &str) -> bool {
+    if !is_temp_name(name) {
+        return false;
+    }
+    let mut parts = name[..name.len() - TEMP_SUFFIX.len()].rsplitn(3, '.');
+    let (_random, pid) = (parts.next(), parts.next());
+    pid.and_then(|p| p.parse::<u32>().ok())
+        .is_some_and(|p| !process_alive(p))
 }
 
 /// Whether process `pid` exists (it may have been reused: then its temporary files stay).

@@ -64,6 +64,29 @@ impl RunDir {
     pub fn create(scene_dir: &Path, base: &str) -> Result<RunDir> {
         super::create_dir(scene_dir)?;
         mark_dead_runs(scene_dir);
+        // Built under a temporary name (with this process's pid, see `is_dead_temp`), locked and
+        // with its run.json, then renamed into place: a run directory never exists without
+        // both, so a free lock on one always means a dead run.
+        let mut builder = tempfile::Builder::new();
+        let prefix = format!(".{base}.{}.", std::process::id());
+        builder.prefix(&prefix).suffix(super::TEMP_SUFFIX);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            builder.permissions(std::fs::Permissions::from_mode(0o777));
+        }
+        let tmp = builder
+            .tempdir_in(scene_dir)
+            .map_err(|e| Error::io(scene_dir, e))?;
+        let lock_path = tmp.path().join(LOCK);
+        let lock = super::open_lock(&lock_path, true)?;
+        lock.lock().map_err(|e| Error::io(&lock_path, e))?;
+        let building = Shared {
+            path: tmp.path().to_path_buf(),
+            record: Mutex::new(None),
+            keep: AtomicBool::new(false),
+        };
+        building.write(Value::Object(Default::default()), Status::Running, None)?;
         let mut k = 1u32;
         let path = loop {
             let name = if k == 1 {
@@ -72,9 +95,17 @@ impl RunDir {
                 format!("{base}-{k}")
             };
             let path = scene_dir.join(name);
-            match std::fs::create_dir(&path) {
+            // rename(2) replaces only an empty directory; a run directory never is one.
+            match std::fs::rename(tmp.path(), &path) {
                 Ok(()) => break path,
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && k < 10_000 => k += 1,
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::AlreadyExists | std::io::ErrorKind::DirectoryNotEmpty
+                    ) && k < 10_000 =>
+                {
+                    k += 1
+                }
                 Err(e) => {
                     return Err(Error::Output {
                         path,
@@ -83,20 +114,18 @@ impl RunDir {
                 }
             }
         };
-        let lock_path = path.join(LOCK);
-        let lock = File::create(&lock_path).map_err(|e| Error::io(&lock_path, e))?;
-        lock.lock().map_err(|e| Error::io(&lock_path, e))?;
+        // Renamed: nothing left for the temporary directory to remove.
+        let _ = tmp.keep();
         let shared = Arc::new(Shared {
             path: path.clone(),
-            record: Mutex::new(None),
+            record: Mutex::new(
+                building
+                    .record
+                    .into_inner()
+                    .unwrap_or_else(|p| p.into_inner()),
+            ),
             keep: AtomicBool::new(false),
         });
-        // Written while locked, so that a run.json saying `running` with a free lock means a
-        // dead run (see `mark_dead_runs`).
-        if let Err(e) = shared.write(Value::Object(Default::default()), Status::Running, None) {
-            let _ = std::fs::remove_dir_all(&path);
-            return Err(e);
-        }
         let on_exit = shared.clone();
         let hook = crate::interrupt::on_exit(move || on_exit.abandon(Status::Interrupted, None));
         Ok(RunDir {
@@ -177,7 +206,12 @@ fn mark_dead_runs(scene_dir: &Path) {
     };
     for e in entries.flatten() {
         let dir = e.path();
-        let Ok(lock) = File::open(dir.join(LOCK)) else {
+        // A run directory being built by a process that died.
+        if super::is_dead_temp(&e.file_name().to_string_lossy()) {
+            let _ = std::fs::remove_dir_all(&dir);
+            continue;
+        }
+        let Ok(lock) = super::open_lock(&dir.join(LOCK), false) else {
             continue;
         };
         if lock.try_lock().is_err() {

@@ -144,12 +144,7 @@ impl Store {
 
     fn acquire(&self, stem: &str, exclusive: bool) -> Result<Locked<'_>> {
         let path = self.dir.join(format!(".{stem}.lock"));
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
-            .open(&path)
-            .map_err(|e| Error::io(&path, e))?;
+        let file = super::open_lock(&path, true)?;
         let _polling = crate::interrupt::polling();
         let mut said = false;
         loop {

@@ -222,7 +222,7 @@ impl Scene {
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
         let desc: SceneFile = toml::from_str(text).map_err(|e| Error::Parse {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            message: shorten_lines(&e.to_string()),
         })?;
         let mut hasher = Sha256::new();
         hasher.update(text.as_bytes());
@@ -640,6 +640,19 @@ impl Scene {
             ),
         ))
     }
+}
+
+/// The parser quotes the offending line: a line of a megabyte is cut to its start.
+fn shorten_lines(message: &str) -> String {
+    const LONGEST: usize = 200;
+    let lines: Vec<String> = message
+        .lines()
+        .map(|l| match l.char_indices().nth(LONGEST) {
+            Some((at, _)) => format!("{}…", &l[..at]),
+            None => l.to_string(),
+        })
+        .collect();
+    lines.join("\n")
 }
 
 /// `bytes` as UTF-8 text, or an error giving the line and column of the first byte that is not.

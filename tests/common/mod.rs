@@ -343,18 +343,40 @@ pub fn check_run_dir(dir: &Path, settled: bool) -> Result<serde_json::Value, Str
     Ok(meta)
 }
 
-/// The run directories of a scene's results directory (everything but `reference`).
+/// The run directories of a scene's results directory (all but `reference` and hidden ones,
+/// which are run directories being built).
 pub fn run_dirs(scene_dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(scene_dir)
         .into_iter()
         .flatten()
         .flatten()
         .map(|e| e.path())
-        .filter(|p| p.is_dir() && !p.ends_with("reference"))
+        .filter(|p| {
+            let hidden = p
+                .file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with('.'));
+            p.is_dir() && !hidden && !p.ends_with("reference")
+        })
         .collect();
     v.sort();
     v
 }
+
+/// A quick compare of [`TINY`] (saved as `tiny.toml`) into `out`: one strategy, 10 ms.
+pub const QUICK_COMPARE: [&str; 12] = [
+    "compare",
+    "tiny.toml",
+    "--time",
+    "0.01",
+    "--reference-spp",
+    "16",
+    "--strategies",
+    "light",
+    "--threads",
+    "1",
+    "--out",
+    "out",
+];
 
 /// A small scene: a quad light over a floor, so light and direction strategies apply.
 pub const TINY: &str = r#"
