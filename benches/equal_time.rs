@@ -42,9 +42,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             eprintln!("{name}: skipping `{}`: {}", k.name, k.reason);
         }
         let mut images = Vec::new();
+        let store = dibench::harness::reference::store(&out, &scene.scene.name)?;
         for integrand in integrands(&scene) {
             images.push(compare::Reference::load_or_render(
-                &out,
+                &store,
                 &scene,
                 integrand,
                 REFERENCE_SPP,
@@ -60,7 +61,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             isa: dibench::simd::Isa::detect()?.name().to_string(),
         };
         let references = compare::References { images };
-        let report = compare::run(&scene, &strategies, skipped, &references, &out, &opts)?;
+        let run_dir = compare::create_run_dir(&out, &scene.scene.name, 1)?;
+        let report = compare::run(&scene, &strategies, skipped, &references, &run_dir, &opts)?;
         println!(
             "equal_time/{name}: {runs} runs × {time_s} s, {}",
             report.run_dir.display()

@@ -8,7 +8,7 @@ use crate::simd::Isa;
 use crate::strategy::{self, Strategy};
 use crate::tracer::backends;
 use clap::{Args, Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -61,9 +61,9 @@ pub enum Command {
 #[derive(Args, Debug)]
 pub struct StressArgs {
     /// Samples per (case, strategy).
-    #[arg(long, default_value_t = 200_000)]
+    #[arg(long, default_value_t = 200_000, allow_negative_numbers = true)]
     pub samples: u64,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Only these cases (comma-separated; see --list).
     #[arg(long, value_delimiter = ',')]
@@ -78,7 +78,7 @@ pub struct StressArgs {
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
     /// Worker threads (default: all cores); the result does not depend on it.
-    #[arg(long)]
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: Option<usize>,
 }
 
@@ -101,10 +101,10 @@ pub struct CrosscheckArgs {
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
     /// Seed of the ray sets and of the renders.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Worker threads for the renders (ray tracing and timing are single-threaded).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: Option<usize>,
 }
 
@@ -117,10 +117,10 @@ pub struct Common {
     #[arg(long, default_value = "results")]
     pub out: PathBuf,
     /// Seed of the random streams: same scene, seed and threads give the same image.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: Option<usize>,
     /// Tracer backend: packet (default), obvhs, or embree when built with --features embree.
     #[arg(long, default_value = backends::DEFAULT)]
@@ -136,17 +136,17 @@ pub struct CompareArgs {
     #[command(flatten)]
     pub common: Common,
     /// Wall-clock budget per strategy, in seconds.
-    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 2.0, value_parser = parse_seconds, allow_hyphen_values = true)]
     pub time: f64,
     /// Samples per pixel of the reference rendered when no matching one is stored.
-    #[arg(long, default_value_t = 8192)]
+    #[arg(long, default_value_t = 8192, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub reference_spp: u64,
     /// Comma-separated subset of strategies to run (default: every applicable one).
     #[arg(long, value_delimiter = ',')]
     pub strategies: Option<Vec<String>>,
     /// Independent runs per strategy (seeds seed, seed+1, ...); summary.csv gives 95 %
     /// confidence intervals over them.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub runs: u32,
 }
 
@@ -161,12 +161,12 @@ pub struct WarpArgs {
     #[arg(long = "param", value_parser = parse_param)]
     pub params: Vec<(String, f64)>,
     /// Number of samples.
-    #[arg(long, default_value_t = 1_000_000)]
+    #[arg(long, default_value_t = 1_000_000, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub samples: u64,
     /// Significance level of the test.
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = 0.01, value_parser = parse_alpha, allow_hyphen_values = true)]
     pub alpha: f64,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
     /// Write the observed histogram beside the expected counts as a PNG.
     #[arg(long)]
@@ -180,7 +180,60 @@ fn parse_param(s: &str) -> std::result::Result<(String, f64), String> {
     let v: f64 = v
         .parse()
         .map_err(|_| format!("parameter `{k}`: `{v}` is not a number"))?;
+    // The samplers compute in f32: a larger value would become infinite there.
+    if v.abs() > f32::MAX as f64 {
+        return Err(format!(
+            "parameter `{k}`: {v:e} is beyond the f32 range (±{:e}) the samplers compute in",
+            f32::MAX
+        ));
+    }
     Ok((k.to_string(), v))
+}
+
+/// Longest accepted time budget: about 31 years, far below what `Duration` holds.
+const MAX_SECONDS: f64 = 1e9;
+/// Shortest accepted time budget: below a millisecond the clock's resolution is the budget.
+const MIN_SECONDS: f64 = 1e-3;
+
+fn parse_seconds(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(t) if (MIN_SECONDS..=MAX_SECONDS).contains(&t) => Ok(t),
+        _ => Err(format!(
+            "expected a number of seconds from {MIN_SECONDS} to {MAX_SECONDS:e}"
+        )),
+    }
+}
+
+fn parse_alpha(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(a) if a > 0.0 && a < 1.0 => Ok(a),
+        _ => Err("expected a significance level strictly between 0 and 1".into()),
+    }
+}
+
+fn parse_rounds(s: &str) -> std::result::Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("expected a whole number from 1 to {}", usize::MAX)),
+    }
+}
+
+/// The most worker threads accepted: 1024, or the number of cores where there are more.
+/// Beyond the cores threads only add contention, and creating tens of thousands takes minutes.
+pub fn max_threads() -> usize {
+    std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .max(1024)
+}
+
+fn parse_threads(s: &str) -> std::result::Result<usize, String> {
+    let max = max_threads();
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected a whole number of threads from 1 to {max} (1024, or the cores if more)"
+        )),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -188,15 +241,48 @@ pub struct ReferenceArgs {
     #[command(flatten)]
     pub common: Common,
     /// Samples per pixel (default 8192).
-    #[arg(long, conflicts_with = "time")]
+    #[arg(long, conflicts_with = "time", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
     pub spp: Option<u64>,
     /// Render whole passes for this many seconds instead of a fixed spp.
-    #[arg(long, allow_negative_numbers = true)]
+    #[arg(long, value_parser = parse_seconds, allow_hyphen_values = true)]
     pub time: Option<f64>,
     /// Render only shard i of n (passes i, i+n, ... of --spp) into <out>/<scene>/reference/
     /// shards/, for a cluster job array; `dibench merge` then writes the reference.
-    #[arg(long, conflicts_with = "time")]
+    #[arg(long, conflicts_with = "time", allow_hyphen_values = true)]
     pub shard: Option<String>,
+}
+
+/// Which command-line arguments are not UTF-8, each with the option it is the value of
+/// (clap's own error does not say).
+pub fn invalid_utf8_args() -> String {
+    let args: Vec<std::ffi::OsString> = std::env::args_os().collect();
+    let shown = |a: &std::ffi::OsStr| {
+        #[cfg(unix)]
+        {
+            use std::os::unix::ffi::OsStrExt;
+            a.as_bytes().escape_ascii().to_string()
+        }
+        #[cfg(not(unix))]
+        {
+            a.to_string_lossy().into_owned()
+        }
+    };
+    let bad: Vec<String> = (1..args.len())
+        .filter(|&i| args[i].to_str().is_none())
+        .map(|i| {
+            let of = args[i - 1]
+                .to_str()
+                .filter(|p| p.starts_with('-'))
+                .map(|p| format!(" (the value of {p})"))
+                .unwrap_or_default();
+            format!("argument {i} `{}`{of}", shown(&args[i]))
+        })
+        .collect();
+    format!(
+        "{} is not valid UTF-8: scene names and paths given as SCENE, and every name or number, \
+         must be UTF-8 text",
+        bad.join(", ")
+    )
 }
 
 fn load(scene: &str) -> Result<PreparedScene> {
@@ -207,7 +293,7 @@ fn load(scene: &str) -> Result<PreparedScene> {
 /// `--isa`, else `DIBENCH_ISA`, else the best the CPU has.
 fn isa(arg: &Option<String>) -> Result<Isa> {
     match arg {
-        Some(s) => Isa::parse(s),
+        Some(s) => Isa::parse(s).map_err(|e| Error::Usage(format!("--isa {s}: {e}"))),
         None => Isa::detect(),
     }
 }
@@ -215,11 +301,16 @@ fn isa(arg: &Option<String>) -> Result<Isa> {
 /// Loads a scene traced by the backend (and ISA) `c` names.
 fn load_with(c: &Common) -> Result<PreparedScene> {
     backends::check(&c.backend)?;
-    let isa = if c.backend == "packet" {
-        Some(isa(&c.isa)?)
-    } else {
-        None
-    };
+    // A misspelt --isa is an error with any backend; a valid one that the backend has no use
+    // for is said, not silently dropped.
+    let chosen = isa(&c.isa)?;
+    if c.isa.is_some() && c.backend != "packet" {
+        crate::interrupt::note(&format!(
+            "warning: --isa is ignored: the {} backend has no ISA paths",
+            c.backend
+        ));
+    }
+    let isa = (c.backend == "packet").then_some(chosen);
     let scene = Scene::load(&Scene::resolve(&c.scene)?)?;
     let mut err = None;
     let prepared = PreparedScene::with_tracer(scene, |g| {
@@ -237,15 +328,13 @@ fn load_with(c: &Common) -> Result<PreparedScene> {
     }
 }
 
+/// The worker pool; `--threads` is already bounded by its parser (`parse_threads`).
 fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
     let n = threads.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map(|n| n.get())
             .unwrap_or(1)
     });
-    if n == 0 {
-        return Err(Error::Usage("--threads must be at least 1".into()));
-    }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(n)
         .build()
@@ -258,12 +347,23 @@ fn pool(threads: Option<usize>) -> Result<(rayon::ThreadPool, usize)> {
 /// runs it, reports an error on stderr and maps it to the exit status.
 pub fn main_with(extra: Vec<Box<dyn Strategy>>) -> std::process::ExitCode {
     use std::process::ExitCode;
+    // First: quiet SIGPIPE, reopened standard descriptors, the Ctrl-C handler (`interrupt`).
+    crate::interrupt::install();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if e.kind() == clap::error::ErrorKind::InvalidUtf8 => {
+            // clap does not say which argument; name it.
+            crate::interrupt::note(&format!("error: {}", invalid_utf8_args()));
+            return ExitCode::from(2);
+        }
+        Err(e) => e.exit(),
+    };
     let mut strategies = strategy::registry();
     strategies.extend(extra);
-    match run_with(Cli::parse(), strategies) {
+    match run_with(cli, strategies) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            crate::interrupt::note(&format!("error: {e}"));
             match e {
                 // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C.
                 Error::Interrupted(_) => ExitCode::from(130),
@@ -298,8 +398,8 @@ pub fn run_with(cli: Cli, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         Command::Crosscheck(a) => run_crosscheck(a),
         Command::Stress(a) => run_stress(a),
         Command::Merge { scene, out } => {
-            let name = Scene::load(&Scene::resolve(&scene)?)?.name;
-            for p in crate::harness::shard::merge(&out, &name)? {
+            let scene = Scene::load(&Scene::resolve(&scene)?)?;
+            for p in crate::harness::shard::merge(&out, &scene)? {
                 println!("reference: {}", p.display());
             }
             Ok(())
@@ -332,7 +432,10 @@ fn run_stress(a: StressArgs) -> Result<()> {
         }
         cases.retain(|c| names.contains(&c.name));
     }
+    let path = a.out.join("stress").join("stress.csv");
+    crate::output::check_output_dir(&a.out.join("stress"), "--out")?;
     if let Some(dir) = &a.export {
+        crate::output::check_output_dir(dir, "--export")?;
         for c in &cases {
             c.write_to(dir)?;
         }
@@ -340,7 +443,6 @@ fn run_stress(a: StressArgs) -> Result<()> {
     }
     let (pool, threads) = pool(a.threads)?;
     let rows = pool.install(|| stress::run(&cases, a.samples, a.seed))?;
-    let path = a.out.join("stress").join("stress.csv");
     crate::output::write_csv(&path, &rows)?;
     println!(
         "{} cases · {} samples per strategy · seed {} · {threads} threads",
@@ -413,22 +515,30 @@ fn run_stress(a: StressArgs) -> Result<()> {
 }
 
 fn run_reference(a: ReferenceArgs) -> Result<()> {
-    // Ctrl-C stops between passes and keeps what is complete (see `interrupt`).
-    crate::interrupt::install();
+    use crate::harness::shard;
+    let spec = a
+        .shard
+        .as_deref()
+        .map(shard::ShardSpec::parse)
+        .transpose()?;
     let (pool, threads) = pool(a.common.threads)?;
     let scene = load_with(&a.common)?;
+    scene.scene.require_light_power()?;
+    // The film, its mean and variance, and a checkpoint being written.
+    check_image_memory(&scene, 3)?;
     let budget = match (a.spp, a.time) {
         (_, Some(t)) => reference::Budget::Time(t),
         (n, None) => reference::Budget::Spp(n.unwrap_or(8192)),
     };
-    if let Some(s) = &a.shard {
-        let spec = crate::harness::shard::ShardSpec::parse(s)?;
+    crate::output::check_output_dir(&a.common.out, "--out")?;
+    if let Some(spec) = spec {
+        let store = shard::store(&a.common.out, &scene.scene.name)?;
         let total = a.spp.unwrap_or(8192);
         for integrand in strategy::integrands(&scene) {
-            let (film, meta) = pool.install(|| {
-                crate::harness::shard::render(&scene, integrand, total, a.common.seed, spec)
-            })?;
-            let path = crate::harness::shard::save_shard(&a.common.out, &film, &meta)?;
+            let unit = store.lock(&shard::stem(integrand.name(), spec))?;
+            let (film, meta) =
+                pool.install(|| shard::render(&scene, integrand, total, a.common.seed, spec))?;
+            let path = shard::save_shard(&unit, &film, &meta)?;
             println!(
                 "shard {}/{}: {} ({} of {total} spp, {:.1} s, {threads} threads)",
                 spec.index,
@@ -440,7 +550,11 @@ fn run_reference(a: ReferenceArgs) -> Result<()> {
         }
         return Ok(());
     }
+    let store = reference::store(&a.common.out, &scene.scene.name)?;
     for integrand in strategy::integrands(&scene) {
+        // Locked while it renders: a concurrent `compare` waits for it instead of rendering
+        // its own, and checkpoints of two processes never interleave.
+        let unit = store.lock(integrand.name())?;
         let r = pool.install(|| {
             reference::render_progressive(
                 &scene,
@@ -448,10 +562,10 @@ fn run_reference(a: ReferenceArgs) -> Result<()> {
                 budget,
                 a.common.seed,
                 threads,
-                Some(&a.common.out),
+                Some(&unit),
             )
         })?;
-        let path = reference::save(&a.common.out, &r.image, &r.variance, &r.meta)?;
+        let path = reference::save(&unit, &r.image, &r.variance, &r.meta)?;
         println!(
             "reference: {} ({} spp, {:.1} s, strategy {}, noise floor {:.3e} RMSE)",
             path.display(),
@@ -464,23 +578,40 @@ fn run_reference(a: ReferenceArgs) -> Result<()> {
     Ok(())
 }
 
+/// Refuses, before anything is rendered, a scene whose image needs more memory than there is:
+/// the film (sum and M2, 48 bytes per pixel), `images` more f64 RGB images (24 bytes each:
+/// references, the mean, the variance) and EXR encoding (16 bytes).
+fn check_image_memory(scene: &PreparedScene, images: u64) -> Result<()> {
+    let s = &scene.scene;
+    crate::bounded::check_memory(
+        || {
+            format!(
+                "{}: field `image`: {}×{} pixels",
+                s.path.display(),
+                s.width,
+                s.height
+            )
+        },
+        image_memory(scene, images),
+    )
+}
+
+fn image_memory(scene: &PreparedScene, images: u64) -> u64 {
+    crate::bounded::bytes(scene.scene.pixel_count() as u64, 48 + 24 * images + 16)
+}
+
 fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
-    // Ctrl-C stops between passes and keeps what is complete (see `interrupt`).
-    crate::interrupt::install();
-    let (pool, threads) = pool(a.common.threads)?;
-    if !(a.time.is_finite() && a.time > 0.0) {
+    let seed = a.common.seed;
+    if seed.checked_add(a.runs as u64 - 1).is_none() {
         return Err(Error::Usage(format!(
-            "--time must be a positive number of seconds, got {}",
-            a.time
+            "--seed {seed} with --runs {}: the seeds {seed}…{seed}+{} pass 2^64 − 1",
+            a.runs,
+            a.runs - 1
         )));
     }
-    if a.reference_spp == 0 {
-        return Err(Error::Usage("--reference-spp must be at least 1".into()));
-    }
-    if a.runs == 0 {
-        return Err(Error::Usage("--runs must be at least 1".into()));
-    }
+    let (pool, threads) = pool(a.common.threads)?;
     let scene = load_with(&a.common)?;
+    scene.scene.require_light_power()?;
     let known: Vec<String> = strategies.iter().map(|s| s.name()).collect();
     let (mut run, mut skipped) = strategy::split_applicable(strategies, &scene);
     if let Some(wanted) = &a.strategies {
@@ -501,17 +632,32 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
         run.retain(|s| wanted.contains(&s.name()));
         skipped.retain(|k| wanted.contains(&k.name));
     }
+    // References (one per integrand), the film's mean, its variance and a checkpoint's mean;
+    // then per (strategy, run) its rows and summary input, about 3 kB.
+    let integrands = strategy::integrands(&scene).len() as u64;
+    check_image_memory(&scene, integrands + 3)?;
+    crate::bounded::check_memory(
+        || format!("--runs {} (strategies: {})", a.runs, run.len()),
+        image_memory(&scene, integrands + 3).saturating_add(crate::bounded::bytes(
+            a.runs as u64 * run.len() as u64,
+            3000,
+        )),
+    )?;
+    // The output location is checked, and the run's directory taken, before any rendering.
+    crate::output::check_output_dir(&a.common.out, "--out")?;
+    let run_dir = compare::create_run_dir(&a.common.out, &scene.scene.name, seed)?;
+    let store = reference::store(&a.common.out, &scene.scene.name)?;
     for k in &skipped {
         eprintln!("skipping strategy `{}`: {}", k.name, k.reason);
     }
-    pool.install(|| -> Result<()> {
+    let result = pool.install(|| -> Result<()> {
         let mut images = Vec::new();
         for integrand in strategy::integrands(&scene) {
             if !run.iter().any(|s| s.integrand() == integrand) {
                 continue;
             }
             images.push(compare::Reference::load_or_render(
-                &a.common.out,
+                &store,
                 &scene,
                 integrand,
                 a.reference_spp,
@@ -527,7 +673,7 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
             runs: a.runs,
             isa: isa_path(&a.common)?,
         };
-        let report = compare::run(&scene, &run, skipped, &references, &a.common.out, &opts)?;
+        let report = compare::run(&scene, &run, skipped, &references, &run_dir, &opts)?;
         let spp: Vec<String> = references
             .images
             .iter()
@@ -597,7 +743,11 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
         }
         println!("results: {}", report.run_dir.display());
         Ok(())
-    })
+    });
+    if let Err(e) = &result {
+        run_dir.abandon(e);
+    }
+    result
 }
 
 fn compare_warnings(rows: &[crate::harness::summary::SummaryRow]) -> Vec<String> {
@@ -655,16 +805,11 @@ fn run_warp(a: WarpArgs) -> Result<()> {
             known.join(", ")
         ))
     })?;
-    if a.samples == 0 {
-        return Err(Error::Usage("--samples must be at least 1".into()));
-    }
-    if !(a.alpha > 0.0 && a.alpha < 1.0) {
-        return Err(Error::Usage(format!(
-            "--alpha must be in (0, 1), got {}",
-            a.alpha
-        )));
-    }
     let params = entry.params(&a.params).map_err(Error::Usage)?;
+    if let Some(png) = &a.png {
+        let dir = png.parent().filter(|d| !d.as_os_str().is_empty());
+        crate::output::check_output_dir(dir.unwrap_or(Path::new(".")), "--png")?;
+    }
     let case =
         (entry.build)(&params).map_err(|e| Error::Usage(format!("sampler `{name}`: {e}")))?;
     let r = crate::chi2::run(&case, a.samples, 40, 80, a.seed);
@@ -707,15 +852,15 @@ pub struct RaysArgs {
     #[arg(long)]
     pub isa: Option<String>,
     /// Tracing threads (default 1: single-thread throughput).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = parse_threads, allow_negative_numbers = true)]
     pub threads: usize,
     /// Image side of the ray sets, in pixels.
-    #[arg(long, default_value_t = 512)]
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=crate::scene::MAX_IMAGE_SIDE as i64), allow_negative_numbers = true)]
     pub size: u32,
     /// Timing rounds (best round is reported; order alternates between rounds).
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = 5, value_parser = parse_rounds, allow_negative_numbers = true)]
     pub rounds: usize,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
 }
 
@@ -725,11 +870,6 @@ fn run_rays(a: RaysArgs) -> Result<()> {
             return Err(rays::unknown_backend(b));
         }
     }
-    if a.size == 0 || a.rounds == 0 {
-        return Err(Error::Usage(
-            "--size and --rounds must be at least 1".into(),
-        ));
-    }
     let isas = match (&a.isa, std::env::var("DIBENCH_ISA")) {
         (Some(s), _) => vec![Isa::parse(s)?],
         (None, Ok(s)) if !s.is_empty() => vec![Isa::detect()?],
@@ -738,10 +878,16 @@ fn run_rays(a: RaysArgs) -> Result<()> {
     let (pool, threads) = pool(Some(a.threads))?;
     let scene = load(&a.scene)?;
     let name = scene.scene.name.clone();
+    let path = a.out.join(&name).join("rays.csv");
+    crate::output::check_output_dir(&a.out.join(&name), "--out")?;
+    // Four sets of size² rays, with their packets and masks: about 256 bytes per ray.
+    crate::bounded::check_memory(
+        || format!("--size {}", a.size),
+        crate::bounded::bytes(a.size as u64 * a.size as u64, 256),
+    )?;
     let sets = rays::generate(&scene, a.size, a.seed);
     let subjects = rays::subjects(&scene, &a.backend, &isas)?;
     let rows = pool.install(|| rays::measure(&name, &sets, &subjects, a.rounds, threads));
-    let path = a.out.join(&name).join("rays.csv");
     crate::output::write_csv(&path, &rows)?;
     println!(
         "scene {name} · {} threads · {}x{} rays per class · best of {} rounds",
@@ -789,6 +935,9 @@ fn run_rays(a: RaysArgs) -> Result<()> {
 fn run_crosscheck(a: CrosscheckArgs) -> Result<()> {
     let (pool, _) = pool(a.threads)?;
     let mut scene = load(&a.scene)?;
+    crate::output::check_output_dir(&a.out.join(&scene.scene.name), "--out")?;
+    // A render per backend and pass beside the ray sets.
+    check_image_memory(&scene, 8)?;
     if backends::AVAILABLE.len() < 2 {
         eprintln!("crosscheck: only one backend is compiled in");
     }

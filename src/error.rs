@@ -22,6 +22,18 @@ pub enum Error {
     Usage(String),
     #[error("{path}: {message}")]
     Output { path: PathBuf, message: String },
+    /// A size or count from a flag or a file that would need more memory than there is,
+    /// found before anything was allocated (`bounded`).
+    #[error(
+        "{what}: needs about {} of memory, {} available",
+        crate::bounded::human_bytes(*need),
+        crate::bounded::human_bytes(*available)
+    )]
+    Memory {
+        what: String,
+        need: u64,
+        available: u64,
+    },
     /// Ctrl-C or SIGTERM: the command stopped early after writing what was complete.
     #[error("interrupted: {0}")]
     Interrupted(String),

@@ -4,6 +4,7 @@
 //! needs) → [`tracer`] → [`strategy`] → [`film`] → [`metrics`] → [`output`] (CSV/EXR), driven
 //! by [`harness`].
 
+pub mod bounded;
 pub mod bsdf;
 pub mod chi2;
 pub mod cli;

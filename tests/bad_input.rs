@@ -1,7 +1,7 @@
 //! Bad input gets a clear error naming the file and the field, a non-zero exit, and no panic.
 
 mod common;
-use common::dibench;
+use common::{dibench, stored_file};
 
 use dibench::scene::Scene;
 use std::path::Path;
@@ -213,10 +213,10 @@ fn cli_compare_writes_exrs_and_csv() {
             "no rows for {s}"
         );
     }
-    assert!(dir.path().join("out/ok/reference/direct.exr").is_file());
+    let stored = stored_file(&dir.path().join("out/ok/reference/direct.json"), "image");
+    assert!(stored.is_file());
 
     // A truncated stored reference is an error naming it, not a panic or a silent re-render.
-    let stored = dir.path().join("out/ok/reference/direct.exr");
     let bytes = std::fs::read(&stored).unwrap();
     std::fs::write(&stored, &bytes[..bytes.len() / 3]).unwrap();
     let (code, _, stderr) = dibench(
@@ -233,7 +233,8 @@ fn cli_compare_writes_exrs_and_csv() {
         dir.path(),
     );
     assert_ne!(code, 0, "a truncated reference was accepted");
-    assert!(stderr.contains("direct.exr"), "{stderr}");
+    let name = stored.file_name().unwrap().to_string_lossy();
+    assert!(stderr.contains(&*name), "{stderr}");
     let leftovers: Vec<_> = walk(&dir.path().join("out"))
         .into_iter()
         .filter(|p| p.to_string_lossy().contains(".tmp-"))

@@ -2,7 +2,7 @@
 //! metadata, reference noise floor and checkpoints, plots, and errors for bad arguments.
 
 mod common;
-use common::dibench;
+use common::{dibench, stored_file};
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -192,8 +192,8 @@ fn reference_noise_floor_predicts_the_difference_of_two_references() {
             "the final save replaces the 64 and 128 spp checkpoints"
         );
         floors.push(meta["noise_floor_rmse"].as_f64().unwrap());
-        images.push(read_exr(&refdir.join("direct.exr")).unwrap());
-        assert!(refdir.join("direct.variance.exr").is_file());
+        images.push(read_exr(&stored_file(&refdir.join("direct.json"), "image")).unwrap());
+        assert!(stored_file(&refdir.join("direct.json"), "variance").is_file());
     }
     let d2: Vec<f64> = images[0]
         .pixels
@@ -378,12 +378,16 @@ fn sharded_reference_merges_to_the_single_process_one() {
     let (code, _, stderr) = dibench(&["merge", "tiny.toml", "--out", "sharded"], dir.path());
     assert_eq!(code, 0, "{stderr}");
     for name in ["direct", "ao"] {
-        let read = |root: &str, file: String| {
-            dibench::output::read_exr(&dir.path().join(root).join("tiny/reference").join(file))
-                .unwrap()
+        let read = |root: &str, role: &str| {
+            let manifest = dir
+                .path()
+                .join(root)
+                .join("tiny/reference")
+                .join(format!("{name}.json"));
+            dibench::output::read_exr(&stored_file(&manifest, role)).unwrap()
         };
-        for file in [format!("{name}.exr"), format!("{name}.variance.exr")] {
-            let (a, b) = (read("single", file.clone()), read("sharded", file.clone()));
+        for file in ["image", "variance"] {
+            let (a, b) = (read("single", file), read("sharded", file));
             assert_eq!(a.pixels.len(), b.pixels.len());
             let mut worst = 0.0f64;
             for (p, q) in a.pixels.iter().zip(&b.pixels) {
@@ -420,4 +424,64 @@ fn sharded_reference_merges_to_the_single_process_one() {
     );
     assert_eq!(code, 1);
     assert!(stderr.contains("--shard must be i/n"), "{stderr}");
+}
+
+/// A reference interrupted early never replaces a stored one of the same scene with more
+/// samples: its checkpoints are skipped while they have fewer (a rerun after a kill used to
+/// lose the better reference).
+#[test]
+fn an_interrupted_reference_keeps_the_better_stored_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = SCENE
+        .replace("width = 16", "width = 32")
+        .replace("height = 12", "height = 32")
+        .replace("[ambient_occlusion]\ndistance = 0.5\n", "");
+    std::fs::write(dir.path().join("tiny.toml"), scene).unwrap();
+    let args = ["reference", "tiny.toml", "--threads", "1", "--out", "out"];
+    let start = std::time::Instant::now();
+    let (code, _, stderr) = dibench(&[&args[..], &["--spp", "1024"]].concat(), dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    // A third of that time: past the first checkpoints, well short of 1024 spp, on any machine.
+    let a_third = start.elapsed() / 3;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dibench"))
+        .args([&args[..], &["--spp", "100000000", "--seed", "2"]].concat())
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(a_third);
+    common::signal(child.id(), libc::SIGINT);
+    let status = child.wait().unwrap();
+    let mut stderr = String::new();
+    use std::io::Read;
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    assert_eq!(status.code(), Some(130), "{stderr}");
+    let meta: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(dir.path().join("out/tiny/reference/direct.json")).unwrap(),
+    )
+    .unwrap();
+    let stopped: u64 = stderr
+        .split("stopped at ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{stderr}"));
+    assert!(
+        stopped >= 64,
+        "stopped before the first checkpoint: {stderr}"
+    );
+    if stopped < 1024 {
+        assert_eq!(
+            (meta["seed"].as_u64(), meta["spp"].as_u64()),
+            (Some(1), Some(1024)),
+            "{stderr}"
+        );
+        assert!(stderr.contains("no checkpoint of it stored"), "{stderr}");
+    }
 }

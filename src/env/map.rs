@@ -3,6 +3,8 @@
 //! load; a non-finite texel is an error naming the file and the texel.
 
 use super::latlong;
+use crate::error::{Error, Result};
+use crate::output::decode_exr;
 use glam::Vec3;
 use std::path::Path;
 
@@ -17,31 +19,31 @@ pub struct LatLongImage {
 }
 
 impl LatLongImage {
-    /// Reads the first RGB(A) layer of `path`; the message names the file.
-    pub fn load(path: &Path) -> Result<Self, String> {
-        use exr::prelude::*;
-        let image = read_first_rgba_layer_from_file(
-            path,
-            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
-            },
-        )
-        .map_err(|e| format!("cannot read EXR {}: {e}", path.display()))?;
-        let (width, mut pixels) = image.layer_data.channel_data.pixels;
-        let height = pixels.len() / width.max(1);
+    /// Reads the first RGB(A) layer of the EXR file `path` (see [`Self::decode`]); the
+    /// message names the file.
+    pub fn load(path: &Path) -> std::result::Result<Self, String> {
+        crate::bounded::read_file(path, 0)
+            .and_then(|bytes| Self::decode(&bytes, path))
+            .map_err(|e| e.to_string())
+    }
+
+    /// Decodes the first RGB(A) layer of the EXR `bytes` read from `path` (which errors name);
+    /// the header's size is checked before pixel memory is allocated (`output::decode_exr`).
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<Self> {
+        let (width, height, mut pixels) = decode_exr(bytes, path, Vec3::new)?;
         if width == 0 || height == 0 {
-            return Err(format!("{}: the image is empty", path.display()));
+            return Err(Error::Parse {
+                path: path.into(),
+                message: "the image is empty".into(),
+            });
         }
         let mut clamped = 0;
         for (k, p) in pixels.iter_mut().enumerate() {
             if !p.is_finite() {
-                return Err(format!(
-                    "{}: texel ({}, {}) is not finite: {p}",
-                    path.display(),
-                    k % width,
-                    k / width
-                ));
+                return Err(Error::Parse {
+                    path: path.into(),
+                    message: format!("texel ({}, {}) is not finite: {p}", k % width, k / width),
+                });
             }
             if p.min_element() < 0.0 {
                 *p = p.max(Vec3::ZERO);
@@ -66,7 +68,7 @@ impl LatLongImage {
 }
 
 /// Writes a lat/long image as a losslessly compressed (ZIP, scan-line, f32) EXR, atomically.
-pub fn write_latlong(path: &Path, img: &LatLongImage) -> crate::error::Result<()> {
+pub fn write_latlong(path: &Path, img: &LatLongImage) -> Result<()> {
     let film = crate::film::Image {
         width: img.width as u32,
         height: img.height as u32,

@@ -9,7 +9,9 @@ use super::{COMMIT, RUSTC, VERSION, cpu_model, progress_bar};
 use crate::error::{Error, Result};
 use crate::film::{Film, Image};
 use crate::metrics::{relmse, rmse};
-use crate::output::{write_csv, write_exr, write_json};
+use crate::output::run_dir::{RunDir, Status};
+use crate::output::store::Store;
+use crate::output::{write_csv, write_exr};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy::{Integrand, Skipped, Strategy};
@@ -69,9 +71,9 @@ struct RunMeta<'a> {
     dibench_version: &'a str,
     rustc: &'a str,
     commit: &'a str,
-    /// Set (and run.json rewritten) when Ctrl-C stopped the run: only `completed` (strategy,
-    /// run) pairs are in results.csv and summary.csv.
-    interrupted: bool,
+    /// The (strategy, run) pairs whose rows are in results.csv and images written; `run_dir`
+    /// adds `status` (`running`, `complete`, `interrupted`, `failed`, `unfinished`), whether the
+    /// run was interrupted, and the error that ended it.
     completed: Vec<(String, u32)>,
 }
 
@@ -104,11 +106,13 @@ pub fn run_strategy(
     run: u32,
     mut on_progress: impl FnMut(Duration),
 ) -> Result<StrategyRun> {
-    let seed = opts.seed + run as u64;
+    let seed = opts.seed.wrapping_add(run as u64);
     let mut renderer = Renderer::new(scene, strategy, seed)?;
     let name = strategy.name();
     let mut film = Film::new(scene.scene.width, scene.scene.height);
-    let budget = Duration::from_secs_f64(opts.time_s);
+    // Validated where the options are built (`--time`); saturating for other callers.
+    let budget = Duration::try_from_secs_f64(opts.time_s).unwrap_or(Duration::MAX);
+    let _polling = crate::interrupt::polling();
     let checkpoint_at = |k: u32| budget.div_f64(2f64.powi((CHECKPOINTS - 1 - k) as i32));
     let mut rows = Vec::new();
     let mut next = 0u32;
@@ -188,9 +192,10 @@ pub struct References {
 
 impl Reference {
     /// The stored reference of `integrand` with at least `spp` samples for this exact scene
-    /// content, else a fresh one rendered (with `seed`) and stored. Says which on stderr.
+    /// content, else a fresh one rendered (with `seed`) and stored. Says which on stderr. The
+    /// unit stays locked while it renders, so a concurrent run waits and then reuses it.
     pub fn load_or_render(
-        out: &Path,
+        store: &Store,
         scene: &PreparedScene,
         integrand: Integrand,
         spp: u64,
@@ -198,8 +203,9 @@ impl Reference {
         threads: usize,
     ) -> Result<Reference> {
         use super::reference;
-        let dir = reference::reference_dir(out, &scene.scene.name);
-        let (image, meta) = match reference::load_matching(out, scene, integrand, spp)? {
+        let dir = store.dir();
+        let unit = store.lock(integrand.name())?;
+        let (image, meta) = match reference::load_matching(&unit, scene, spp)? {
             Some(r) => {
                 eprintln!(
                     "reference ({}): reusing {} spp from {}",
@@ -215,7 +221,7 @@ impl Reference {
                     integrand.name()
                 );
                 let r = reference::render(scene, integrand, spp, seed, threads)?;
-                reference::save(out, &r.image, &r.variance, &r.meta)?;
+                reference::save(&unit, &r.image, &r.variance, &r.meta)?;
                 eprintln!(
                     "reference ({}): {:.1} s with `{}`",
                     integrand.name(),
@@ -240,16 +246,25 @@ impl References {
     }
 }
 
-/// Runs `strategies` at equal time, `opts.runs` times each, and writes
-/// `<out>/<scene>/<run-id>/`: per strategy the run-0 image and its per-pixel variance of the
-/// mean (`<strategy>.exr`, `<strategy>.variance.exr`), `results.csv` (rewritten after each
-/// strategy, so an interrupted run keeps what finished), `summary.csv` and `run.json`.
+/// Creates the run directory `<out>/<scene>/<time>-seed<N>` (exclusively: `-2`, `-3`, … when
+/// the name is taken) before anything is rendered, so a bad `--out` is reported at once.
+pub fn create_run_dir(out: &Path, scene: &str, seed: u64) -> Result<RunDir> {
+    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())
+        .to_string()
+        .replace(':', "-");
+    RunDir::create(&out.join(scene), &format!("{stamp}-seed{seed}"))
+}
+
+/// Runs `strategies` at equal time, `opts.runs` times each, and writes into `run_dir`: per
+/// strategy the run-0 image and its per-pixel variance of the mean (`<strategy>.exr`,
+/// `<strategy>.variance.exr`), `results.csv` (rewritten after each strategy, so an interrupted
+/// run keeps what finished), `summary.csv` and `run.json` (which says how complete the run is).
 pub fn run(
     scene: &PreparedScene,
     strategies: &[Box<dyn Strategy>],
     skipped: Vec<Skipped>,
     references: &References,
-    out: &Path,
+    run_dir: &RunDir,
     opts: &CompareOptions,
 ) -> Result<CompareReport> {
     if !(opts.time_s.is_finite() && opts.time_s > 0.0) {
@@ -267,13 +282,7 @@ pub fn run(
             scene.scene.name
         )));
     }
-    let stamp = humantime::format_rfc3339_seconds(std::time::SystemTime::now())
-        .to_string()
-        .replace(':', "-");
-    let run_dir = out
-        .join(&scene.scene.name)
-        .join(format!("{stamp}-seed{}", opts.seed));
-    let meta = RunMeta {
+    let mut meta = RunMeta {
         scene: &scene.scene.name,
         scene_hash: &scene.scene.content_hash,
         width: scene.scene.width,
@@ -283,7 +292,9 @@ pub fn run(
         threads: opts.threads,
         cpu_model: cpu_model(),
         runs: opts.runs,
-        seeds: (0..opts.runs as u64).map(|k| opts.seed + k).collect(),
+        seeds: (0..opts.runs as u64)
+            .map(|k| opts.seed.wrapping_add(k))
+            .collect(),
         budget_s: opts.time_s,
         strategies: strategies.iter().map(|s| s.name()).collect(),
         skipped: &skipped,
@@ -300,11 +311,10 @@ pub fn run(
         dibench_version: VERSION,
         rustc: RUSTC,
         commit: COMMIT,
-        interrupted: false,
         completed: Vec::new(),
     };
-    let mut meta = meta;
-    write_json(&run_dir.join("run.json"), &meta)?;
+    let dir = run_dir.path();
+    run_dir.record(&meta, Status::Running)?;
     let mut rows = Vec::new();
     let mut finals = Vec::new();
     let budget_ms = (opts.time_s * 1000.0).ceil() as u64;
@@ -331,26 +341,18 @@ pub fn run(
                 // Keep what finished (results.csv is already written), summarise it, record
                 // the interruption; the unfinished strategy leaves no file behind.
                 if !finals.is_empty() {
-                    write_csv(
-                        &run_dir.join("summary.csv"),
-                        &summarize(&finals, opts.time_s),
-                    )?;
+                    write_csv(&dir.join("summary.csv"), &summarize(&finals, opts.time_s))?;
                 }
-                meta.interrupted = true;
-                write_json(&run_dir.join("run.json"), &meta)?;
                 return Err(Error::Interrupted(format!(
                     "compare kept {} finished strategy run(s) in {}; `{}` (run {run}) was discarded",
                     meta.completed.len(),
-                    run_dir.display(),
+                    dir.display(),
                     s.name()
                 )));
             }
             if run == 0 {
-                write_exr(&run_dir.join(format!("{}.exr", s.name())), &r.image)?;
-                write_exr(
-                    &run_dir.join(format!("{}.variance.exr", s.name())),
-                    &r.variance,
-                )?;
+                write_exr(&dir.join(format!("{}.exr", s.name())), &r.image)?;
+                write_exr(&dir.join(format!("{}.variance.exr", s.name())), &r.variance)?;
             }
             let last = r.rows.last().cloned().expect("a run has a final row");
             finals.push(FinalRun {
@@ -359,14 +361,17 @@ pub fn run(
                 reference_noise_floor: reference.noise_floor,
             });
             rows.extend(r.rows);
-            write_csv(&run_dir.join("results.csv"), &rows)?;
+            write_csv(&dir.join("results.csv"), &rows)?;
+            run_dir.keep();
             meta.completed.push((s.name().to_string(), run));
+            run_dir.record(&meta, Status::Running)?;
         }
     }
     let summary = summarize(&finals, opts.time_s);
-    write_csv(&run_dir.join("summary.csv"), &summary)?;
+    write_csv(&dir.join("summary.csv"), &summary)?;
+    run_dir.record(&meta, Status::Complete)?;
     Ok(CompareReport {
-        run_dir,
+        run_dir: dir.to_path_buf(),
         rows,
         summary,
         skipped,

@@ -1,11 +1,15 @@
 //! High-sample reference images, stored with the metadata that decides whether `compare` may
-//! reuse them: same scene content hash and resolution, and at least the requested spp.
+//! reuse them: same scene content hash and resolution, and at least the requested spp. Each
+//! integrand's reference is one unit of the store `<out>/<scene>/reference/` (see
+//! `output::store`): its image, its variance and its metadata are committed together, and the
+//! unit is locked while it is rendered, so that concurrent runs render it once.
 
 use super::{COMMIT, VERSION, progress_bar};
 use crate::error::{Error, Result};
 use crate::film::{Film, Image};
 use crate::math::mix64;
-use crate::output::{read_exr, write_exr, write_json};
+use crate::output::store::{Locked, NewFile, Store};
+use crate::output::{decode_exr, encode_exr};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy::{Integrand, reference_strategy};
@@ -37,6 +41,11 @@ pub struct ReferenceMeta {
 
 pub fn reference_dir(out: &Path, scene: &str) -> PathBuf {
     out.join(scene).join("reference")
+}
+
+/// The reference store of `scene` under `out`, created if missing.
+pub fn store(out: &Path, scene: &str) -> Result<Store> {
+    Store::open(&reference_dir(out, scene))
 }
 
 /// The reference's random streams are salted so that they never coincide with the streams of
@@ -88,26 +97,28 @@ pub fn render(
     render_progressive(scene, integrand, Budget::Spp(spp), seed, threads, None)
 }
 
-/// Renders a reference; with `checkpoint_out`, saves it (image, variance, JSON) at 64, 128,
-/// 256, ... spp so an interrupted render keeps its latest power of two. A stored checkpoint
-/// carries its own spp, so `compare` reuses it only when that is enough.
+/// Renders a reference; with `checkpoints` (the unit, locked), commits it (image, variance,
+/// JSON) at 64, 128, 256, ... spp so an interrupted render keeps its latest power of two. A
+/// stored checkpoint carries its own spp, so `compare` reuses it only when that is enough.
 pub fn render_progressive(
     scene: &PreparedScene,
     integrand: Integrand,
     budget: Budget,
     seed: u64,
     threads: usize,
-    checkpoint_out: Option<&Path>,
+    checkpoints: Option<&Locked>,
 ) -> Result<Rendered> {
     let (spp, time) = match budget {
         Budget::Spp(0) => return Err(Error::Usage("--spp must be at least 1".into())),
         Budget::Spp(n) => (n, None),
-        Budget::Time(t) if !(t.is_finite() && t > 0.0) => {
-            return Err(Error::Usage(format!(
-                "--time must be a positive number of seconds, got {t}"
-            )));
-        }
-        Budget::Time(t) => (u64::MAX, Some(Duration::from_secs_f64(t))),
+        Budget::Time(t) => match Duration::try_from_secs_f64(t) {
+            Ok(d) if d > Duration::ZERO => (u64::MAX, Some(d)),
+            _ => {
+                return Err(Error::Usage(format!(
+                    "--time must be a positive number of seconds, got {t}"
+                )));
+            }
+        },
     };
     let strategy = strategy_for(scene, integrand)?;
     let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
@@ -135,14 +146,14 @@ pub fn render_progressive(
         commit: COMMIT.to_string(),
     };
     let mut next_checkpoint = FIRST_CHECKPOINT_SPP;
+    let mut saved = None;
+    let _polling = crate::interrupt::polling();
     loop {
         if crate::interrupt::requested() {
             bar.finish_and_clear();
-            let kept = match checkpoint_out {
-                Some(_) if next_checkpoint > FIRST_CHECKPOINT_SPP => {
-                    format!("; the {} spp checkpoint is stored", next_checkpoint / 2)
-                }
-                _ => "; nothing stored".to_string(),
+            let kept = match saved {
+                Some(spp) => format!("; the {spp} spp checkpoint is stored"),
+                None => "; no checkpoint of it stored".to_string(),
             };
             return Err(Error::Interrupted(format!(
                 "{} reference for `{}` stopped at {} spp{kept}",
@@ -160,11 +171,26 @@ pub fn render_progressive(
         }
         renderer.add_pass(&mut film);
         bar.inc(1);
-        if let Some(out) = checkpoint_out
+        if let Some(unit) = checkpoints
             && film.spp == next_checkpoint
         {
-            save(out, &film.mean(), &film.variance_of_mean(), &meta_of(&film))?;
-            next_checkpoint *= 2;
+            // A checkpoint never replaces a stored reference of this content with more
+            // samples (reruns after kills would otherwise lose it); the final save does.
+            let better_stored = unit.meta::<ReferenceMeta>()?.is_some_and(|m| {
+                m.scene_hash == scene.scene.content_hash
+                    && (m.width, m.height) == (scene.scene.width, scene.scene.height)
+                    && m.spp > film.spp
+            });
+            if !better_stored {
+                save(
+                    unit,
+                    &film.mean(),
+                    &film.variance_of_mean(),
+                    &meta_of(&film),
+                )?;
+                saved = Some(film.spp);
+            }
+            next_checkpoint = next_checkpoint.saturating_mul(2);
         }
     }
     bar.finish_and_clear();
@@ -175,36 +201,42 @@ pub fn render_progressive(
     })
 }
 
-/// Writes `<integrand>.exr`, its per-pixel variance of the mean `<integrand>.variance.exr`,
-/// and `<integrand>.json`; the JSON last, so a stored JSON always describes its images.
-pub fn save(out: &Path, image: &Image, variance: &Image, meta: &ReferenceMeta) -> Result<PathBuf> {
-    let dir = reference_dir(out, &meta.scene);
-    let exr = dir.join(format!("{}.exr", meta.integrand));
-    write_exr(&exr, image)?;
-    write_exr(
-        &dir.join(format!("{}.variance.exr", meta.integrand)),
-        variance,
-    )?;
-    write_json(&dir.join(format!("{}.json", meta.integrand)), meta)?;
-    Ok(exr)
+/// Commits the reference (image, per-pixel variance of the mean, metadata) as the content of
+/// the unit `unit` (locked for writing; named by the integrand); returns the manifest's path.
+pub fn save(
+    unit: &Locked,
+    image: &Image,
+    variance: &Image,
+    meta: &ReferenceMeta,
+) -> Result<PathBuf> {
+    unit.commit(
+        meta,
+        vec![
+            NewFile {
+                role: "image",
+                ext: "exr",
+                write: Box::new(|p| encode_exr(p, image, p)),
+            },
+            NewFile {
+                role: "variance",
+                ext: "variance.exr",
+                write: Box::new(|p| encode_exr(p, variance, p)),
+            },
+        ],
+    )
 }
 
-/// A stored reference for exactly this scene content and resolution with at least `min_spp`.
+/// The stored reference of `unit` if it is for exactly this scene content and resolution and
+/// has at least `min_spp`; a damaged one is an error naming the file.
 pub fn load_matching(
-    out: &Path,
+    unit: &Locked,
     scene: &PreparedScene,
-    integrand: Integrand,
     min_spp: u64,
 ) -> Result<Option<(Image, ReferenceMeta)>> {
-    let dir = reference_dir(out, &scene.scene.name);
-    let json = dir.join(format!("{}.json", integrand.name()));
-    let Ok(text) = std::fs::read_to_string(&json) else {
+    let Some(stored) = unit.read::<ReferenceMeta>()? else {
         return Ok(None);
     };
-    let meta: ReferenceMeta = serde_json::from_str(&text).map_err(|e| Error::Parse {
-        path: json.clone(),
-        message: e.to_string(),
-    })?;
+    let meta = stored.meta.clone();
     if meta.scene_hash != scene.scene.content_hash
         || meta.width != scene.scene.width
         || meta.height != scene.scene.height
@@ -212,9 +244,28 @@ pub fn load_matching(
     {
         return Ok(None);
     }
-    let image = read_exr(&dir.join(format!("{}.exr", integrand.name())))?;
-    if image.width != meta.width || image.height != meta.height {
-        return Ok(None);
+    let (path, bytes) = stored.file("image")?;
+    let (width, height, pixels) =
+        decode_exr(bytes, path, |r, g, b| [r as f64, g as f64, b as f64])?;
+    let bad = |message: String| Error::Parse {
+        path: path.to_path_buf(),
+        message,
+    };
+    if (width, height) != (meta.width as usize, meta.height as usize) {
+        return Err(bad(format!(
+            "{width}×{height} pixels, but its manifest says {}×{}",
+            meta.width, meta.height
+        )));
     }
-    Ok(Some((image, meta)))
+    if let Some(k) = pixels.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(bad(format!("pixel {k} is not finite")));
+    }
+    Ok(Some((
+        Image {
+            width: meta.width,
+            height: meta.height,
+            pixels,
+        },
+        meta,
+    )))
 }

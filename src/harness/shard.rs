@@ -9,7 +9,7 @@ use super::reference::{ReferenceMeta, reference_dir, reference_stream_seed, save
 use super::{COMMIT, VERSION};
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::output::{write_bytes, write_json};
+use crate::output::store::{Locked, NewFile, Store};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy::Integrand;
@@ -60,12 +60,24 @@ pub struct ShardMeta {
     pub commit: String,
 }
 
-fn shard_dir(out: &Path, scene: &str) -> PathBuf {
-    reference_dir(out, scene).join("shards")
+/// The shard store of `scene` under `out`, `<out>/<scene>/reference/shards/` (created if
+/// missing): one unit per shard, named by [`stem`].
+pub fn store(out: &Path, scene: &str) -> Result<Store> {
+    Store::open(&reference_dir(out, scene).join("shards"))
 }
 
-fn stem(integrand: &str, s: ShardSpec) -> String {
+/// The unit name of shard `s` of `integrand`'s reference.
+pub fn stem(integrand: &str, s: ShardSpec) -> String {
     format!("{integrand}.{}-of-{}", s.index, s.count)
+}
+
+/// Passes below `total` that shard `s` renders: `index`, `index + count`, …
+fn passes(total: u64, s: ShardSpec) -> u64 {
+    if s.index >= total {
+        0
+    } else {
+        (total - 1 - s.index) / s.count + 1
+    }
 }
 
 /// Renders shard `spec` of a `total_spp` reference of `integrand`.
@@ -83,6 +95,7 @@ pub fn render(
     let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let start = Instant::now();
+    let _polling = crate::interrupt::polling();
     for pass in (spec.index..total_spp).step_by(spec.count as usize) {
         if crate::interrupt::requested() {
             return Err(Error::Interrupted(format!(
@@ -115,108 +128,173 @@ pub fn render(
     Ok((film, meta))
 }
 
-/// Writes `<out>/<scene>/reference/shards/<integrand>.<i>-of-<n>.bin` (little-endian f64:
-/// every pixel's sum, then every pixel's M2, tile-major as in `Film`) and its `.json`, the
-/// JSON last. Returns the JSON's path.
-pub fn save_shard(out: &Path, film: &Film, meta: &ShardMeta) -> Result<PathBuf> {
-    let dir = shard_dir(out, &meta.scene);
-    let spec = ShardSpec {
-        index: meta.index,
-        count: meta.count,
-    };
+/// Commits the shard as the content of `unit` (locked for writing): its film as
+/// little-endian f64 (every pixel's sum, then every pixel's M2, tile-major as in `Film`) and
+/// its metadata. Returns the manifest's path.
+pub fn save_shard(unit: &Locked, film: &Film, meta: &ShardMeta) -> Result<PathBuf> {
     let mut bytes = Vec::with_capacity(film.sum.len() * 48);
     for px in film.sum.iter().chain(film.m2.iter()) {
         for v in px {
             bytes.extend_from_slice(&v.to_le_bytes());
         }
     }
-    write_bytes(
-        &dir.join(format!("{}.bin", stem(&meta.integrand, spec))),
-        &bytes,
-    )?;
-    let json = dir.join(format!("{}.json", stem(&meta.integrand, spec)));
-    write_json(&json, meta)?;
-    Ok(json)
+    unit.commit(
+        meta,
+        vec![NewFile {
+            role: "film",
+            ext: "bin",
+            write: Box::new(|p| std::fs::write(p, &bytes).map_err(|e| Error::io(p, e))),
+        }],
+    )
 }
 
-/// A shard's JSON path, film and metadata.
+/// A shard's manifest path, film and metadata.
 type LoadedShard = (PathBuf, Film, ShardMeta);
 
-fn load_shard(json: &Path) -> Result<(Film, ShardMeta)> {
-    let text = std::fs::read_to_string(json).map_err(|e| Error::io(json, e))?;
-    let meta: ShardMeta = serde_json::from_str(&text).map_err(|e| Error::Parse {
-        path: json.to_path_buf(),
-        message: e.to_string(),
-    })?;
-    let bin = json.with_extension("bin");
-    let bytes = std::fs::read(&bin).map_err(|e| Error::io(&bin, e))?;
-    let mut film = Film::new(meta.width, meta.height);
-    let want = film.sum.len() * 2 * 3 * 8;
-    if bytes.len() != want {
+/// The shard in `unit`, its metadata checked against itself and its film's size before the
+/// film is allocated; None when nothing is committed there.
+fn load_shard(unit: &Locked) -> Result<Option<LoadedShard>> {
+    let Some(stored) = unit.read::<ShardMeta>()? else {
+        return Ok(None);
+    };
+    let (meta, json) = (stored.meta.clone(), stored.manifest.clone());
+    let lie = |message: String| Error::Parse {
+        path: json.clone(),
+        message,
+    };
+    if meta.count == 0 || meta.index >= meta.count {
+        return Err(lie(format!(
+            "shard {}/{}: the index must be below the count",
+            meta.index, meta.count
+        )));
+    }
+    let spec = ShardSpec {
+        index: meta.index,
+        count: meta.count,
+    };
+    if meta.spp != passes(meta.total_spp, spec) {
+        return Err(lie(format!(
+            "claims {} spp, but shard {}/{} of {} spp has {}",
+            meta.spp,
+            meta.index,
+            meta.count,
+            meta.total_spp,
+            passes(meta.total_spp, spec)
+        )));
+    }
+    if !(1..=crate::scene::MAX_IMAGE_SIDE).contains(&meta.width)
+        || !(1..=crate::scene::MAX_IMAGE_SIDE).contains(&meta.height)
+    {
+        return Err(lie(format!(
+            "claims a {}×{} image (sides must be in 1..={})",
+            meta.width,
+            meta.height,
+            crate::scene::MAX_IMAGE_SIDE
+        )));
+    }
+    let (bin, bytes) = stored.file("film")?;
+    let pixels = crate::film::TileLayout::new(meta.width, meta.height).tile_count() as u64 * 16;
+    let want = pixels * 2 * 3 * 8;
+    if bytes.len() as u64 != want {
         return Err(Error::Parse {
-            path: bin,
+            path: bin.to_path_buf(),
             message: format!(
-                "{} bytes, expected {want} for {}x{}",
+                "{} bytes, expected {want} for the {}×{} film its manifest {} claims",
                 bytes.len(),
                 meta.width,
-                meta.height
+                meta.height,
+                json.display()
             ),
         });
     }
+    crate::bounded::check_memory(
+        || format!("{}: a {}×{} film", json.display(), meta.width, meta.height),
+        want,
+    )?;
+    let mut film = Film::new(meta.width, meta.height);
     let mut vals = bytes
         .chunks_exact(8)
         .map(|b| f64::from_le_bytes(b.try_into().expect("8 bytes")));
-    let n = film.sum.len();
-    for px in film.sum.iter_mut().chain(film.m2.iter_mut()).take(2 * n) {
+    for px in film.sum.iter_mut().chain(film.m2.iter_mut()) {
         for v in px.iter_mut() {
             *v = vals.next().expect("length checked");
+            if !v.is_finite() {
+                return Err(Error::Parse {
+                    path: bin.to_path_buf(),
+                    message: "holds a non-finite value".into(),
+                });
+            }
         }
     }
     film.spp = meta.spp;
-    Ok((film, meta))
+    Ok(Some((json, film, meta)))
 }
 
 /// Merges every complete set of shards under `<out>/<scene>/reference/shards/` into the
-/// ordinary reference files of its integrand. All n shards of a set must be present and agree
-/// on scene content, resolution, seed and total spp; anything else is an error naming the
-/// file. Returns the reference EXRs written.
-pub fn merge(out: &Path, scene: &str) -> Result<Vec<PathBuf>> {
-    let dir = shard_dir(out, scene);
-    let entries = std::fs::read_dir(&dir).map_err(|e| Error::io(&dir, e))?;
-    let mut jsons: Vec<PathBuf> = entries
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|x| x == "json"))
-        .collect();
-    jsons.sort();
-    if jsons.is_empty() {
+/// reference of its integrand. Every shard must be for the scene's current content and
+/// resolution (else an error naming the scene and the shard), and all n shards of a set must be
+/// present and agree on seed, total spp and strategy; anything else is an error naming the
+/// file. Returns the reference manifests written.
+pub fn merge(out: &Path, scene: &crate::scene::Scene) -> Result<Vec<PathBuf>> {
+    let dir = reference_dir(out, &scene.name).join("shards");
+    if !dir.is_dir() {
         return Err(Error::Usage(format!(
             "{}: no shards to merge",
             dir.display()
         )));
     }
+    let shards = store(out, &scene.name)?;
+    let stems = shards.stems()?;
+    let mut locks = Vec::new();
+    for stem in &stems {
+        locks.push(shards.lock_shared(stem)?);
+    }
     let mut sets: Vec<(String, Vec<LoadedShard>)> = Vec::new();
-    for j in jsons {
-        let (film, meta) = load_shard(&j)?;
+    for unit in &locks {
+        let Some((j, film, meta)) = load_shard(unit)? else {
+            continue;
+        };
+        if meta.scene_hash != scene.content_hash
+            || (meta.width, meta.height) != (scene.width, scene.height)
+        {
+            return Err(Error::Parse {
+                path: j,
+                message: format!(
+                    "this shard was rendered for other content of scene `{}` ({}; {}×{} then, \
+                     {}×{} now): the scene or a file it uses changed since; render the shards again",
+                    scene.name,
+                    scene.path.display(),
+                    meta.width,
+                    meta.height,
+                    scene.width,
+                    scene.height
+                ),
+            });
+        }
         match sets.iter_mut().find(|(k, _)| *k == meta.integrand) {
             Some((_, v)) => v.push((j, film, meta)),
             None => sets.push((meta.integrand.clone(), vec![(j, film, meta)])),
         }
     }
+    if sets.is_empty() {
+        return Err(Error::Usage(format!(
+            "{}: no shards to merge",
+            dir.display()
+        )));
+    }
+    let references = super::reference::store(out, &scene.name)?;
     let mut written = Vec::new();
     for (integrand, mut shards) in sets {
         shards.sort_by_key(|s| s.2.index);
         let first = shards[0].2.clone();
         for (path, _, m) in &shards {
-            let same = m.scene_hash == first.scene_hash
-                && (m.width, m.height) == (first.width, first.height)
-                && (m.seed, m.total_spp, m.count) == (first.seed, first.total_spp, first.count)
+            let same = (m.seed, m.total_spp, m.count) == (first.seed, first.total_spp, first.count)
                 && m.strategy == first.strategy;
             if !same {
                 return Err(Error::Parse {
                     path: path.clone(),
                     message: format!(
-                        "shard does not match {}: scene hash, resolution, seed, total spp, shard count and strategy must agree",
+                        "shard does not match {}: seed, total spp, shard count and strategy must agree",
                         stem(
                             &first.integrand,
                             ShardSpec {
@@ -229,11 +307,14 @@ pub fn merge(out: &Path, scene: &str) -> Result<Vec<PathBuf>> {
             }
         }
         let have: Vec<u64> = shards.iter().map(|s| s.2.index).collect();
+        // At most ten named: a count read from a file may be anything up to 2^64.
         let missing: Vec<String> = (0..first.count)
             .filter(|i| !have.contains(i))
+            .take(10)
             .map(|i| i.to_string())
             .collect();
-        if !missing.is_empty() || have.len() as u64 != first.count {
+        let duplicated = have.windows(2).any(|w| w[0] == w[1]);
+        if !missing.is_empty() || duplicated {
             return Err(Error::Usage(format!(
                 "{}: {integrand} shards {} of {} missing (or duplicated)",
                 dir.display(),
@@ -263,7 +344,8 @@ pub fn merge(out: &Path, scene: &str) -> Result<Vec<PathBuf>> {
             dibench_version: VERSION.to_string(),
             commit: COMMIT.to_string(),
         };
-        written.push(save(out, &film.mean(), &film.variance_of_mean(), &meta)?);
+        let unit = references.lock(&integrand)?;
+        written.push(save(&unit, &film.mean(), &film.variance_of_mean(), &meta)?);
     }
     Ok(written)
 }

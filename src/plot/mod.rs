@@ -98,7 +98,7 @@ where
         y0 = y0.min(y);
         y1 = y1.max(y);
     }
-    if !(t0 > 0.0 && y0 > 0.0 && t1 > t0) {
+    if !(t0 > 0.0 && y0 > 0.0 && t1 >= t0) {
         return Err(plot_err(Path::new("rmse_vs_time"), "no positive data"));
     }
     let mut chart = ChartBuilder::on(&root)
@@ -283,7 +283,8 @@ fn srgb8(v: f64) -> u8 {
 }
 
 fn viridis(t: f64) -> RGBColor {
-    let c = colorous::VIRIDIS.eval_continuous(t.clamp(0.0, 1.0));
+    let t = if t.is_nan() { 0.0 } else { t.clamp(0.0, 1.0) };
+    let c = colorous::VIRIDIS.eval_continuous(t);
     RGBColor(c.r, c.g, c.b)
 }
 
@@ -293,13 +294,17 @@ fn mean_channel(img: &Image, x: u32, y: u32) -> f64 {
 }
 
 /// Writes every figure for `run_dir` into `run_dir/plots/` and returns their paths.
+/// A time or an RMSE a log axis can show, with room to pad the axis by 2× either way.
+fn plottable(v: f64) -> bool {
+    (1e-300..=1e300).contains(&v)
+}
+
 pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
     register_font()?;
     let csv_path = run_dir.join("results.csv");
-    let mut reader = csv::Reader::from_path(&csv_path).map_err(|e| Error::Parse {
-        path: csv_path.clone(),
-        message: e.to_string(),
-    })?;
+    // A CSV row of text becomes a ResultRow of about the same size, strings and all.
+    let bytes = crate::bounded::read_file(&csv_path, 4)?;
+    let mut reader = csv::Reader::from_reader(&bytes[..]);
     let rows: Vec<ResultRow> = reader
         .deserialize()
         .collect::<std::result::Result<_, _>>()
@@ -313,10 +318,34 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
             message: "no result rows".into(),
         });
     }
+    // The names become file names in the run directory, and nothing outside it.
+    if let Some(r) = rows.iter().find(|r| {
+        r.strategy.is_empty() || Path::new(&r.strategy).file_name() != Some(r.strategy.as_ref())
+    }) {
+        return Err(Error::Parse {
+            path: csv_path,
+            message: format!("`{}` is not a strategy name", r.strategy),
+        });
+    }
+    // Non-finite, zero or negative values have no place on a log axis: left out, and said.
+    let (rows_on_axis, off_axis): (Vec<ResultRow>, Vec<ResultRow>) = rows
+        .iter()
+        .cloned()
+        .partition(|r| plottable(r.time_s) && plottable(r.rmse));
+    if !off_axis.is_empty() {
+        crate::interrupt::note(&format!(
+            "plot: {} of {} rows of {} left out of the RMSE chart (time or RMSE not finite and \
+             positive)",
+            off_axis.len(),
+            rows.len(),
+            csv_path.display()
+        ));
+    }
     let dir = run_dir.join("plots");
+    crate::output::check_output_dir(&dir, "RUN_DIR")?;
     let mut written = Vec::new();
 
-    let c = curves(&rows);
+    let c = curves(&rows_on_axis);
     let size = (900, 620);
     let p = dir.join("rmse_vs_time.png");
     png_figure(&p, size, |root| draw_rmse(root, &c))?;
@@ -332,11 +361,24 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
         }
     }
     let images = strategy_images(run_dir, &names, "")?;
-    let (w, h) = (images[0].1.width, images[0].1.height);
-    let strip_size = (
-        GAP + images.len() as u32 * (w * SCALE + GAP),
-        LABEL_H + h * SCALE + GAP,
-    );
+    // Images of different sizes (a tampered run) are laid out by their own sizes.
+    let h = images.iter().map(|(_, i)| i.height).max().unwrap_or(1);
+    let strip_w = images.iter().fold(GAP as u64, |w, (_, i)| {
+        w + i.width as u64 * SCALE as u64 + GAP as u64
+    });
+    let strip_h = (LABEL_H + GAP) as u64 + h as u64 * SCALE as u64;
+    if strip_w > i32::MAX as u64 / 2 || strip_h > i32::MAX as u64 / 2 {
+        return Err(plot_err(
+            &dir,
+            format!("a {strip_w}×{strip_h} strip is too large to draw"),
+        ));
+    }
+    // The strip and the variance figure, RGB8, and their PNG encodings.
+    crate::bounded::check_memory(
+        || format!("{}: a {strip_w}×{strip_h} image strip", run_dir.display()),
+        crate::bounded::bytes(strip_w * strip_h, 12),
+    )?;
+    let strip_size = (strip_w as u32, strip_h as u32);
     let p = dir.join("strip.png");
     png_figure(&p, strip_size, |root| {
         root.fill(&WHITE).map_err(|e| plot_err(&p, e))?;
@@ -348,13 +390,24 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
     written.push(p);
 
     let variances = strategy_images(run_dir, &names, ".variance")?;
+    for ((name, img), (_, var)) in images.iter().zip(&variances) {
+        if (img.width, img.height) != (var.width, var.height) {
+            return Err(Error::Parse {
+                path: run_dir.join(format!("{name}.variance.exr")),
+                message: format!(
+                    "{}×{} pixels, but {name}.exr has {}×{}",
+                    var.width, var.height, img.width, img.height
+                ),
+            });
+        }
+    }
     // One log10 scale over all strategies: the 1st to 99.9th percentile of the positive
     // values, so a few near-zero pixels (light edges) do not stretch the scale; values outside
     // take the ends of the colour bar.
     let mut logs: Vec<f64> = variances
         .iter()
         .flat_map(|(_, img)| img.pixels.iter().map(|p| (p[0] + p[1] + p[2]) / 3.0))
-        .filter(|&v| v > 0.0)
+        .filter(|&v| v > 0.0 && v.is_finite())
         .map(f64::log10)
         .collect();
     logs.sort_by(f64::total_cmp);
@@ -374,7 +427,7 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
         // Zero-variance pixels (e.g. the background) take the bottom of the scale.
         draw_tiles(&root, &variances, |img, x, y| {
             let v = mean_channel(img, x, y);
-            viridis(if v > 0.0 {
+            viridis(if v > 0.0 && v.is_finite() {
                 (v.log10() - lo) / span
             } else {
                 0.0

@@ -4,6 +4,22 @@
 
 use serde::Deserialize;
 
+/// Exactly three numbers: a point, a direction or an RGB triple. serde's `[f32; 3]` would
+/// silently drop a fourth component, so the list is read whole and its length checked (two
+/// components and four are both errors, with the line).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq)]
+#[serde(try_from = "Vec<f32>")]
+pub struct Triple(pub [f32; 3]);
+
+impl TryFrom<Vec<f32>> for Triple {
+    type Error = String;
+    fn try_from(v: Vec<f32>) -> Result<Self, String> {
+        <[f32; 3]>::try_from(v)
+            .map(Triple)
+            .map_err(|v| format!("expected 3 numbers, got {}", v.len()))
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -32,16 +48,16 @@ pub struct SceneFile {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
-    pub eye: [f32; 3],
-    pub look_at: [f32; 3],
+    pub eye: Triple,
+    pub look_at: Triple,
     #[serde(default = "default_up")]
-    pub up: [f32; 3],
+    pub up: Triple,
     /// Full vertical field of view in degrees.
     pub fov_y_deg: f32,
 }
 
-fn default_up() -> [f32; 3] {
-    [0.0, 1.0, 0.0]
+fn default_up() -> Triple {
+    Triple([0.0, 1.0, 0.0])
 }
 
 #[derive(Debug, Deserialize)]
@@ -57,10 +73,10 @@ pub struct MaterialDesc {
     pub name: String,
     /// Diffuse (Lambertian) reflectance kd per channel.
     #[serde(default)]
-    pub albedo: [f32; 3],
+    pub albedo: Triple,
     /// Glossy reflectance ks of a normalized Phong lobe; kd + ks ≤ 1 per channel.
     #[serde(default)]
-    pub specular: [f32; 3],
+    pub specular: Triple,
     /// Phong exponent n ≥ 0 (required when `specular` is non-zero).
     pub exponent: Option<f32>,
 }
@@ -75,7 +91,7 @@ pub struct MeshDesc {
     pub transform: TransformDesc,
     /// Emitted radiance [W/(m² sr)] on the front faces (counter-clockwise winding) makes
     /// this mesh a light.
-    pub emission: Option<[f32; 3]>,
+    pub emission: Option<Triple>,
 }
 
 /// Applied as scale, then rotation about +Y, then translation.
@@ -87,7 +103,7 @@ pub struct TransformDesc {
     #[serde(default)]
     pub rotate_y_deg: f32,
     #[serde(default)]
-    pub translate: [f32; 3],
+    pub translate: Triple,
 }
 
 fn one() -> f32 {
@@ -99,7 +115,7 @@ impl Default for TransformDesc {
         TransformDesc {
             scale: 1.0,
             rotate_y_deg: 0.0,
-            translate: [0.0; 3],
+            translate: Triple::default(),
         }
     }
 }
@@ -109,57 +125,57 @@ impl Default for TransformDesc {
 pub struct QuadDesc {
     /// The parallelogram corner + s·edge_u + t·edge_v, s, t in [0, 1]. Its front side (the side
     /// that emits) is the side of edge_u × edge_v.
-    pub corner: [f32; 3],
-    pub edge_u: [f32; 3],
-    pub edge_v: [f32; 3],
+    pub corner: Triple,
+    pub edge_u: Triple,
+    pub edge_v: Triple,
     pub material: String,
-    pub emission: Option<[f32; 3]>,
+    pub emission: Option<Triple>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SphereDesc {
-    pub center: [f32; 3],
+    pub center: Triple,
     pub radius: f32,
     pub material: String,
     /// Emitted radiance, on both faces: outward, and inward for points inside the sphere.
-    pub emission: Option<[f32; 3]>,
+    pub emission: Option<Triple>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointLightDesc {
-    pub position: [f32; 3],
+    pub position: Triple,
     /// Radiant power Φ [W] per channel; the intensity is Φ/(4π) [W/sr]. Give this or
     /// `intensity`, not both.
-    pub power: Option<[f32; 3]>,
+    pub power: Option<Triple>,
     /// Radiant intensity I [W/sr] per channel.
-    pub intensity: Option<[f32; 3]>,
+    pub intensity: Option<Triple>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpotLightDesc {
-    pub position: [f32; 3],
+    pub position: Triple,
     /// The direction the spot points in (its axis).
-    pub direction: [f32; 3],
+    pub direction: Triple,
     /// Half-angle of the lit cone, degrees in [0, 180].
     pub cone_angle_deg: f32,
     /// Half-angle where the smoothstep falloff starts, degrees in [0, cone_angle_deg]
     /// (default: cone_angle_deg, a hard edge).
     pub falloff_start_deg: Option<f32>,
     /// Power Φ [W] or on-axis intensity I [W/sr]; one of the two.
-    pub power: Option<[f32; 3]>,
-    pub intensity: Option<[f32; 3]>,
+    pub power: Option<Triple>,
+    pub intensity: Option<Triple>,
 }
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DirectionalLightDesc {
     /// The direction the light travels in (from the light towards the scene).
-    pub direction: [f32; 3],
+    pub direction: Triple,
     /// Irradiance E⊥ [W/m²] on a surface facing the light.
-    pub irradiance: [f32; 3],
+    pub irradiance: Triple,
 }
 
 #[derive(Debug, Deserialize)]
@@ -175,7 +191,7 @@ pub struct EnvironmentDesc {
     /// Lat/long RGB EXR, relative to the scene file (orientation: docs/conventions.md).
     pub file: Option<String>,
     /// A constant radiance [W/(m² sr)] instead of a file.
-    pub constant: Option<[f32; 3]>,
+    pub constant: Option<Triple>,
     /// Multiplies the radiance (default 1).
     #[serde(default = "one")]
     pub scale: f32,

@@ -4,6 +4,7 @@
 pub mod file;
 mod obj;
 
+use crate::bounded;
 use crate::env::map::LatLongImage;
 use crate::error::{Error, Result};
 use file::SceneFile;
@@ -11,6 +12,9 @@ use glam::{Quat, Vec3};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// The largest image side a scene may ask for (whether it fits in memory is checked apart).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
 
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -32,6 +36,8 @@ pub struct Scene {
     /// Occlusion distance of the ambient-occlusion integrand, when the scene asks for it.
     pub ao_distance: Option<f32>,
     pub environment: Option<EnvironmentSpec>,
+    /// Total power of the lights [W], luminance-weighted (as light selection weighs them).
+    pub light_power: f64,
 }
 
 /// Environment light as given: the source radiance and how it is placed.
@@ -157,8 +163,14 @@ impl Scene {
     /// source tree this binary was built from).
     pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
         let direct = PathBuf::from(name_or_path);
-        if direct.is_file() {
-            return Ok(direct);
+        match std::fs::metadata(&direct) {
+            Ok(m) if m.is_file() => return Ok(direct),
+            // A FIFO or a device by that name is what the user meant, and cannot be read: say
+            // so rather than look for a scene of that name (a directory may share a name).
+            Ok(m) if !m.is_dir() => {
+                bounded::open_regular(&direct)?;
+            }
+            _ => {}
         }
         let file = if name_or_path.ends_with(".toml") {
             name_or_path.to_string()
@@ -201,15 +213,16 @@ impl Scene {
     }
 
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        Self::parse(&text, path)
+        // The TOML document tree takes a few times the text.
+        let bytes = bounded::read_file(path, 16)?;
+        Self::parse(utf8(&bytes, path)?, path)
     }
 
     /// Parses scene text as if read from `path` (which names errors and anchors mesh files).
     pub fn parse(text: &str, path: &Path) -> Result<Scene> {
         let desc: SceneFile = toml::from_str(text).map_err(|e| Error::Parse {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            message: shorten_lines(&e.to_string()),
         })?;
         let mut hasher = Sha256::new();
         hasher.update(text.as_bytes());
@@ -217,16 +230,13 @@ impl Scene {
         let v = Validator { path };
 
         let camera = v.camera(&desc.camera)?;
-        if desc.image.width == 0
-            || desc.image.height == 0
-            || desc.image.width > 16384
-            || desc.image.height > 16384
-        {
+        let side = 1..=MAX_IMAGE_SIDE;
+        if !side.contains(&desc.image.width) || !side.contains(&desc.image.height) {
             return Err(Error::field(
                 path,
                 "image",
                 format!(
-                    "width and height must be in 1..=16384, got {}×{}",
+                    "width and height must be in 1..={MAX_IMAGE_SIDE}, got {}×{}",
                     desc.image.width, desc.image.height
                 ),
             ));
@@ -296,17 +306,14 @@ impl Scene {
         let mut meshes = Vec::new();
         for (i, m) in desc.meshes.iter().enumerate() {
             let file = base.join(&m.file);
-            let bytes = std::fs::read(&file).map_err(|e| {
-                Error::field(
-                    path,
-                    format!("mesh[{i}].file"),
-                    format!("cannot read {}: {e}", file.display()),
-                )
-            })?;
-            hasher.update(&bytes);
             // Name the scene's field too: the user may not know which scene line the OBJ came from.
-            let (mut positions, triangles) = obj::load(&file)
-                .map_err(|e| Error::field(path, format!("mesh[{i}].file"), e.to_string()))?;
+            let in_field = |e: Error| Error::field(path, format!("mesh[{i}].file"), e.to_string());
+            // Read once, so that what is hashed is what is parsed; OBJ text becomes positions,
+            // indices and then a BVH, some 40 bytes per byte of text.
+            let bytes = bounded::read_file(&file, 40)
+                .map_err(|e| in_field(Error::Usage(format!("cannot read {e}"))))?;
+            hasher.update(&bytes);
+            let (mut positions, triangles) = obj::parse(&bytes, &file).map_err(in_field)?;
             let t = &m.transform;
             if !(t.scale.is_finite() && t.scale > 0.0) {
                 return Err(Error::field(
@@ -454,11 +461,22 @@ impl Scene {
             Some(e) => Some(v.environment(e, base, &mut hasher)?),
         };
 
-        let scene = Scene {
-            name: path
-                .file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_else(|| "scene".into()),
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        // The name is a directory of the results: `..toml` would put them beside all others.
+        if name.is_empty() || name == "." || name == ".." {
+            return Err(Error::Parse {
+                path: path.to_path_buf(),
+                message: format!(
+                    "the file name gives the scene the name `{name}`, which cannot name its \
+                     results directory: rename the file"
+                ),
+            });
+        }
+        let mut scene = Scene {
+            name,
             path: path.to_path_buf(),
             content_hash: format!("{:x}", hasher.finalize()),
             camera,
@@ -473,7 +491,24 @@ impl Scene {
             directional_lights,
             ao_distance,
             environment,
+            light_power: 0.0,
         };
+        for (field, power) in scene.light_powers() {
+            // The selection weights are f32 (`Light::power`); half the range leaves room for
+            // rounding differences between this f64 sum and theirs.
+            if power.is_nan() || power > f32::MAX as f64 / 2.0 {
+                return Err(Error::field(
+                    path,
+                    field,
+                    format!(
+                        "the light's power {power:.3e} W overflows the f32 range dibench renders \
+                         in (at most {:.1e} W): scale its emission down",
+                        f32::MAX as f64 / 2.0
+                    ),
+                ));
+            }
+            scene.light_power += power;
+        }
         if !scene.has_emitters() && !scene.has_delta_lights() && !scene.has_environment() {
             return Err(Error::field(
                 path,
@@ -483,6 +518,158 @@ impl Scene {
         }
         Ok(scene)
     }
+}
+
+impl Scene {
+    /// Each light's power [W] in f64, luminance-weighted, by the formulas of `Light::power`:
+    /// (scene field, power).
+    pub fn light_powers(&self) -> Vec<(String, f64)> {
+        use std::f64::consts::PI;
+        let lum = |c: Vec3| 0.2126 * c.x as f64 + 0.7152 * c.y as f64 + 0.0722 * c.z as f64;
+        let mut out = Vec::new();
+        for (i, m) in self.meshes.iter().enumerate() {
+            if let Some(l) = m.emission {
+                let area: f64 = m
+                    .triangles
+                    .iter()
+                    .map(|t| {
+                        let [a, b, c] = t.map(|k| m.positions[k as usize].as_dvec3());
+                        0.5 * (b - a).cross(c - a).length()
+                    })
+                    .sum();
+                out.push((format!("mesh[{i}].emission"), PI * area * lum(l)));
+            }
+        }
+        for (i, q) in self.quads.iter().enumerate() {
+            if let Some(l) = q.emission {
+                let area = q.edge_u.as_dvec3().cross(q.edge_v.as_dvec3()).length();
+                out.push((format!("quad[{i}].emission"), PI * area * lum(l)));
+            }
+        }
+        for (i, s) in self.spheres.iter().enumerate() {
+            if let Some(l) = s.emission {
+                let r = s.radius as f64;
+                out.push((
+                    format!("sphere[{i}].emission"),
+                    4.0 * PI * PI * r * r * lum(l),
+                ));
+            }
+        }
+        for (i, l) in self.point_lights.iter().enumerate() {
+            out.push((format!("point_light[{i}]"), 4.0 * PI * lum(l.intensity)));
+        }
+        for (i, l) in self.spot_lights.iter().enumerate() {
+            let (c, s) = (l.cos_cone as f64, l.cos_falloff_start as f64);
+            let solid = 2.0 * PI * ((1.0 - s) + 0.5 * (s - c));
+            out.push((format!("spot_light[{i}]"), solid * lum(l.intensity)));
+        }
+        let r = self.bounding_radius();
+        for (i, l) in self.directional_lights.iter().enumerate() {
+            out.push((
+                format!("directional_light[{i}]"),
+                PI * r * r * lum(l.irradiance),
+            ));
+        }
+        if let Some(e) = &self.environment {
+            // ∫ L dω over the source: texel rows of the lat/long map span θ0..θ1 of 2π/W each.
+            let integral = match &e.source {
+                EnvSource::Constant(c) => 4.0 * PI * lum(*c),
+                EnvSource::Image(img) => {
+                    let (w, h) = (img.width as f64, img.height as f64);
+                    img.pixels
+                        .chunks(img.width)
+                        .enumerate()
+                        .map(|(y, row)| {
+                            let band = (PI * y as f64 / h).cos() - (PI * (y + 1) as f64 / h).cos();
+                            2.0 * PI / w * band * row.iter().map(|&p| lum(p)).sum::<f64>()
+                        })
+                        .sum()
+                }
+            };
+            out.push(("environment".into(), PI * r * r * e.scale as f64 * integral));
+        }
+        out
+    }
+
+    /// Radius of a bounding sphere of the geometry, the camera and the point it looks at (as
+    /// `prepare` bounds the scene for distant lights).
+    fn bounding_radius(&self) -> f64 {
+        let (eye, look_at) = (
+            self.camera.eye.as_dvec3(),
+            (self.camera.eye + self.camera.forward).as_dvec3(),
+        );
+        let (mut lo, mut hi) = (eye.min(look_at), eye.max(look_at));
+        let mut add = |p: glam::DVec3| {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        };
+        for m in &self.meshes {
+            m.positions.iter().for_each(|p| add(p.as_dvec3()));
+        }
+        for q in &self.quads {
+            let (c, u, v) = (
+                q.corner.as_dvec3(),
+                q.edge_u.as_dvec3(),
+                q.edge_v.as_dvec3(),
+            );
+            [c, c + u, c + v, c + u + v].into_iter().for_each(&mut add);
+        }
+        for s in &self.spheres {
+            let r = glam::DVec3::splat(s.radius as f64);
+            add(s.center.as_dvec3() - r);
+            add(s.center.as_dvec3() + r);
+        }
+        0.5 * (hi - lo).length()
+    }
+
+    /// An error naming the file and `light` when the lights have no power in total (zero
+    /// emission, a mesh light without area, a black environment map): every image would be
+    /// black, so there is nothing to compare and no reference to render.
+    pub fn require_light_power(&self) -> Result<()> {
+        if self.light_power > 0.0 {
+            return Ok(());
+        }
+        let lights: Vec<String> = self.light_powers().into_iter().map(|(f, _)| f).collect();
+        Err(Error::field(
+            &self.path,
+            "light",
+            format!(
+                "every light has zero power ({}): the image would be black, there is nothing \
+                 to render or compare",
+                lights.join(", ")
+            ),
+        ))
+    }
+}
+
+/// The parser quotes the offending line: a line of a megabyte is cut to its start.
+fn shorten_lines(message: &str) -> String {
+    const LONGEST: usize = 200;
+    let lines: Vec<String> = message
+        .lines()
+        .map(|l| match l.char_indices().nth(LONGEST) {
+            Some((at, _)) => format!("{}…", &l[..at]),
+            None => l.to_string(),
+        })
+        .collect();
+    lines.join("\n")
+}
+
+/// `bytes` as UTF-8 text, or an error giving the line and column of the first byte that is not.
+fn utf8<'a>(bytes: &'a [u8], path: &Path) -> Result<&'a str> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let good = &bytes[..e.valid_up_to()];
+        let line_start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = String::from_utf8_lossy(&good[line_start..]).chars().count() + 1;
+        Error::Parse {
+            path: path.to_path_buf(),
+            message: format!(
+                "line {line}, column {column}: byte 0x{:02X} is not UTF-8 (scene files are UTF-8 text)",
+                bytes[e.valid_up_to()]
+            ),
+        }
+    })
 }
 
 struct Validator<'a> {
@@ -502,7 +689,8 @@ impl Validator<'_> {
         }
     }
 
-    fn vec3(&self, field: &str, a: [f32; 3]) -> Result<Vec3> {
+    fn vec3(&self, field: &str, a: file::Triple) -> Result<Vec3> {
+        let a = a.0;
         if a.iter().all(|c| c.is_finite()) {
             Ok(Vec3::from_array(a))
         } else {
@@ -514,7 +702,7 @@ impl Validator<'_> {
         }
     }
 
-    fn emission(&self, field: &str, e: Option<[f32; 3]>) -> Result<Option<Vec3>> {
+    fn emission(&self, field: &str, e: Option<file::Triple>) -> Result<Option<Vec3>> {
         let Some(e) = e else { return Ok(None) };
         let e = self.vec3(field, e)?;
         if e.min_element() < 0.0 {
@@ -536,16 +724,13 @@ impl Validator<'_> {
         let source = match (&e.file, e.constant) {
             (Some(f), None) => {
                 let file = base.join(f);
-                let bytes = std::fs::read(&file).map_err(|err| {
-                    Error::field(
-                        self.path,
-                        "environment.file",
-                        format!("cannot read {}: {err}", file.display()),
-                    )
-                })?;
+                let in_field = |e: Error| {
+                    Error::field(self.path, "environment.file", format!("cannot read {e}"))
+                };
+                // The decoder checks the image's own size against memory.
+                let bytes = bounded::read_file(&file, 0).map_err(in_field)?;
                 hasher.update(&bytes);
-                let img = LatLongImage::load(&file)
-                    .map_err(|m| Error::field(self.path, "environment.file", m))?;
+                let img = LatLongImage::decode(&bytes, &file).map_err(in_field)?;
                 EnvSource::Image(Arc::new(img))
             }
             (None, Some(c)) => {
@@ -575,6 +760,21 @@ impl Validator<'_> {
                 "must be non-negative",
             ));
         }
+        let brightest = match &source {
+            EnvSource::Image(img) => img
+                .pixels
+                .iter()
+                .map(|p| p.max_element())
+                .fold(0.0, f32::max),
+            EnvSource::Constant(c) => c.max_element(),
+        };
+        if !(scale * brightest).is_finite() {
+            return Err(Error::field(
+                self.path,
+                "environment.scale",
+                format!("{scale} times the brightest radiance {brightest} overflows f32"),
+            ));
+        }
         let angle = self.finite("environment.rotate_y_deg", e.rotate_y_deg)?;
         Ok(EnvironmentSpec {
             source,
@@ -583,7 +783,7 @@ impl Validator<'_> {
         })
     }
 
-    fn unit(&self, field: &str, a: [f32; 3]) -> Result<Vec3> {
+    fn unit(&self, field: &str, a: file::Triple) -> Result<Vec3> {
         let d = self.vec3(field, a)?.normalize_or_zero();
         if d == Vec3::ZERO {
             return Err(Error::field(
@@ -600,8 +800,8 @@ impl Validator<'_> {
     fn power_or_intensity(
         &self,
         light: &str,
-        power: Option<[f32; 3]>,
-        intensity: Option<[f32; 3]>,
+        power: Option<file::Triple>,
+        intensity: Option<file::Triple>,
         solid_angle: f32,
     ) -> Result<Vec3> {
         let (field, value) = match (power, intensity) {
