@@ -1,220 +1,242 @@
-//! The 16-ray packet kernels, generic over [`Lanes`]: one SIMD slab test per visited node
-//! for all active lanes, a (node, lane-mask) stack, and the watertight triangle test of Woop
-//! et al. (JCGT 2013) evaluated across lanes with a per-lane axis permutation.
+//! The 16-ray packet kernels over the wide BVH, generic over [`Lanes`]: per visited node one
+//! 16-lane slab test per child for the active lanes, a (child, lane-mask) stack, children
+//! pushed far to near by the entry distance of their first active lane, and the watertight
+//! triangle test across lanes with a per-lane axis permutation. A node (or leaf) reached by
+//! few lanes is finished one ray at a time (Benthin et al. 2012).
 
-use super::single::{self, Best, prim_hit};
-use super::{FAR_SCALE, HYBRID_LANES, Node, PacketTracer, STACK, TraceStats, safe_inv};
+use super::build::{Block, Child, Kind, Node};
+use super::leaf::{self, Sheared};
+use super::{
+    Best, FAR_SCALE, FAULT_FAR_FIRST, HYBRID_LANES, PacketTracer, Ray1, STACK, TraceStats,
+    safe_inv, single,
+};
 use crate::geometry::Ray;
-use crate::geometry::triangle::{Triangle, WatertightRay};
-use crate::simd::{Kernel, Lanes, Mask, WIDTH};
-use crate::tracer::{HitPacket, LaneMask, RayPacket};
+use crate::geometry::triangle::WatertightRay;
+use crate::simd::{Kernel, Lanes, Mask, Vector, WIDTH};
+use crate::tracer::{CULL_SCALE, HitPacket, LaneMask, RayPacket};
 
-/// Per-packet constants, computed once per lane in scalar code.
-struct Prep {
-    o: [[f32; WIDTH]; 3],
-    inv: [[f32; WIDTH]; 3],
-    shear: [[f32; WIDTH]; 3],
+/// Per-packet constants.
+struct Prep<V> {
+    o: [V; 3],
+    inv: [V; 3],
+    shear: [V; 3],
     /// `kmask[j][c]`: lanes whose j-th permuted axis (kx, ky, kz) is c (c = 0, 1; else 2).
-    kmask: [[Mask; 2]; 3],
+    kmask: [[u32; 2]; 3],
+    /// The permutation when every lane shares it (a shared direction, most camera tiles).
+    uniform: Option<[usize; 3]>,
     wr: [WatertightRay; WIDTH],
     rays: [Ray; WIDTH],
 }
 
-impl Prep {
-    fn new(p: &RayPacket) -> Self {
-        let mut prep = Prep {
-            o: [p.ox, p.oy, p.oz],
-            inv: [p.dx.map(safe_inv), p.dy.map(safe_inv), p.dz.map(safe_inv)],
-            shear: [[0.0; WIDTH]; 3],
-            kmask: [[0; 2]; 3],
-            wr: [WatertightRay::new(glam::Vec3::Z); WIDTH],
-            rays: [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z, 0.0); WIDTH],
-        };
+impl<V: Vector<WIDTH>> Prep<V> {
+    #[inline(always)]
+    fn new(p: &RayPacket, active: LaneMask) -> Self {
+        let mut shear = [[0.0; WIDTH]; 3];
+        let mut kmask = [[0u32; 2]; 3];
+        let mut wr = [WatertightRay::new(glam::Vec3::Z); WIDTH];
+        let mut rays = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z, 0.0); WIDTH];
+        let mut uniform = None;
+        let mut mixed = false;
         for l in 0..WIDTH {
             let ray = p.get(l);
             // Inactive lanes may hold a zero direction; their constants are never used.
-            let wr = if ray.dir == glam::Vec3::ZERO {
+            let w = if active & (1 << l) == 0 {
                 WatertightRay::new(glam::Vec3::Z)
             } else {
-                WatertightRay::new(ray.dir)
+                let w = WatertightRay::new(ray.dir);
+                match uniform {
+                    None => uniform = Some(w.axes()),
+                    Some(k) => mixed |= k != w.axes(),
+                }
+                w
             };
-            let (k, s) = (wr.axes(), wr.shear());
+            let (k, s) = (w.axes(), w.shear());
             for j in 0..3 {
-                prep.shear[j][l] = s[j];
+                shear[j][l] = s[j];
                 for c in 0..2 {
                     if k[j] == c {
-                        prep.kmask[j][c] |= 1 << l;
+                        kmask[j][c] |= 1 << l;
                     }
                 }
             }
-            prep.wr[l] = wr;
-            prep.rays[l] = ray;
+            wr[l] = w;
+            rays[l] = ray;
         }
-        prep
+        let mut inv = [[0.0; WIDTH]; 3];
+        for l in 0..WIDTH {
+            inv[0][l] = safe_inv(p.dx[l]);
+            inv[1][l] = safe_inv(p.dy[l]);
+            inv[2][l] = safe_inv(p.dz[l]);
+        }
+        Prep {
+            o: [V::load(&p.ox), V::load(&p.oy), V::load(&p.oz)],
+            inv: [V::load(&inv[0]), V::load(&inv[1]), V::load(&inv[2])],
+            shear: [V::load(&shear[0]), V::load(&shear[1]), V::load(&shear[2])],
+            kmask,
+            uniform: if mixed { None } else { uniform },
+            wr,
+            rays,
+        }
+    }
+
+    /// Per lane, component `k[j]` of (x, y, z).
+    #[inline(always)]
+    fn pick(&self, j: usize, v: &[V; 3]) -> V {
+        match self.uniform {
+            Some(k) => v[k[j]],
+            None => {
+                let m = &self.kmask[j];
+                V::select(m[0], v[0], V::select(m[1], v[1], v[2]))
+            }
+        }
+    }
+
+    /// One triangle in every lane's sheared space.
+    #[inline(always)]
+    fn sheared(&self, blk: &Block, slot: usize) -> Sheared<V> {
+        let z = V::splat(0.0);
+        let mut s = Sheared {
+            x: [z; 3],
+            y: [z; 3],
+            z: [z; 3],
+        };
+        for vtx in 0..3 {
+            let v = &blk.v[vtx];
+            let p = [
+                V::splat(v[0][slot]).sub(self.o[0]),
+                V::splat(v[1][slot]).sub(self.o[1]),
+                V::splat(v[2][slot]).sub(self.o[2]),
+            ];
+            let (px, py, pz) = (self.pick(0, &p), self.pick(1, &p), self.pick(2, &p));
+            s.x[vtx] = px.sub(self.shear[0].mul(pz));
+            s.y[vtx] = py.sub(self.shear[1].mul(pz));
+            s.z[vtx] = self.shear[2].mul(pz);
+        }
+        s
     }
 }
 
-/// Lanes whose ray meets the node's box within (0, tmax).
+/// Lanes whose ray meets child `i`'s box within (0, cull); entry distances in `near_out`.
 #[inline(always)]
-fn slab<L: Lanes>(o: &[L::V; 3], inv: &[L::V; 3], n: &Node, tmax: L::V) -> Mask {
-    let mut near = L::splat(0.0);
-    let mut far = L::splat(f32::INFINITY);
+fn slab<V: Vector<WIDTH>>(
+    n: &Node,
+    i: usize,
+    p: &Prep<V>,
+    cull: V,
+    near_out: &mut [f32; WIDTH],
+) -> u32 {
+    let mut near = V::splat(0.0);
+    let mut far = V::splat(f32::INFINITY);
     for a in 0..3 {
-        let t0 = L::mul(L::sub(L::splat(n.min[a]), o[a]), inv[a]);
-        let t1 = L::mul(L::sub(L::splat(n.max[a]), o[a]), inv[a]);
-        near = L::max(L::min(t0, t1), near);
-        far = L::min(L::max(t0, t1), far);
+        let t0 = V::splat(n.b[a][i]).sub(p.o[a]).mul(p.inv[a]);
+        let t1 = V::splat(n.b[3 + a][i]).sub(p.o[a]).mul(p.inv[a]);
+        near = t0.min(t1).max(near);
+        far = t0.max(t1).min(far);
     }
-    let far = L::min(tmax, L::mul(far, L::splat(FAR_SCALE)));
-    L::le(near, far)
+    let far = far.mul(V::splat(FAR_SCALE)).min(cull);
+    near.store(near_out);
+    near.le(far)
 }
 
-/// Picks, per lane, component `k` of (x, y, z) by the lane's permutation masks.
-#[inline(always)]
-fn pick<L: Lanes>(m: &[Mask; 2], v: &[L::V; 3]) -> L::V {
-    L::select(m[0], v[0], L::select(m[1], v[1], v[2]))
+/// A (child, lane-mask) stack.
+struct Stack {
+    e: [(Child, Mask); STACK],
+    sp: usize,
 }
 
-/// Watertight triangle test on the lanes in `m`, against per-lane `tmax`. Hit lanes get
-/// (t, b1, b2) in `out`. Operations mirror `Triangle::intersect` one for one (no FMA), so
-/// t and barycentrics are bit-identical; lanes with an exactly-zero edge function take the
-/// scalar path, which redoes them in f64.
-#[inline(always)]
-fn triangle<L: Lanes>(
-    tri: &Triangle,
-    prep: &Prep,
-    o: &[L::V; 3],
-    shear: &[L::V; 3],
-    tmax: &[f32; WIDTH],
-    m: Mask,
-    out: &mut [[f32; WIDTH]; 3],
-) -> Mask {
-    let rel = |p: glam::Vec3| -> [L::V; 3] {
-        [
-            L::sub(L::splat(p.x), o[0]),
-            L::sub(L::splat(p.y), o[1]),
-            L::sub(L::splat(p.z), o[2]),
-        ]
-    };
-    let (a, b, c) = (rel(tri.v0), rel(tri.v1), rel(tri.v2));
-    let km = &prep.kmask;
-    let (akz, bkz, ckz) = (
-        pick::<L>(&km[2], &a),
-        pick::<L>(&km[2], &b),
-        pick::<L>(&km[2], &c),
-    );
-    let ax = L::sub(pick::<L>(&km[0], &a), L::mul(shear[0], akz));
-    let ay = L::sub(pick::<L>(&km[1], &a), L::mul(shear[1], akz));
-    let bx = L::sub(pick::<L>(&km[0], &b), L::mul(shear[0], bkz));
-    let by = L::sub(pick::<L>(&km[1], &b), L::mul(shear[1], bkz));
-    let cx = L::sub(pick::<L>(&km[0], &c), L::mul(shear[0], ckz));
-    let cy = L::sub(pick::<L>(&km[1], &c), L::mul(shear[1], ckz));
-    let u = L::sub(L::mul(cx, by), L::mul(cy, bx));
-    let v = L::sub(L::mul(ax, cy), L::mul(ay, cx));
-    let w = L::sub(L::mul(bx, ay), L::mul(by, ax));
-    let zero = L::splat(0.0);
-    let edge0 = (L::eq(u, zero) | L::eq(v, zero) | L::eq(w, zero)) & m;
-    let neg = L::lt(u, zero) | L::lt(v, zero) | L::lt(w, zero);
-    let pos = L::lt(zero, u) | L::lt(zero, v) | L::lt(zero, w);
-    let mut hit = m & !edge0 & !(neg & pos);
-    let mut unsure: Mask = 0;
-    let det = L::add(L::add(u, v), w);
-    hit &= !L::eq(det, zero);
-    if hit != 0 {
-        let az = L::mul(shear[2], akz);
-        let bz = L::mul(shear[2], bkz);
-        let cz = L::mul(shear[2], ckz);
-        let ts = L::add(L::add(L::mul(u, az), L::mul(v, bz)), L::mul(w, cz));
-        // ts · sign(det): exact, since sign(det) = ±1.
-        let tss = L::select(L::lt(det, zero), L::sub(zero, ts), ts);
-        let tm = L::load(tmax);
-        hit &= L::lt(zero, tss) & L::lt(tss, L::mul(tm, L::abs(det)));
-        // t within the test's error bound (pbrt-v4 §6.8.7): see `conservative_t_bound`, same
-        // expression, same order as the scalar test, and skipped, as there, for triangles
-        // wholly ahead of the origin along the dominant axis.
-        let ahead = L::lt(zero, az) & L::lt(zero, bz) & L::lt(zero, cz);
-        let check = hit & !ahead;
-        if check != 0 {
-            let amax = |p: L::V, q: L::V, r: L::V| L::max(L::max(L::abs(p), L::abs(q)), L::abs(r));
-            let (max_xt, max_yt) = (amax(ax, bx, cx), amax(ay, by, cy));
-            let (max_zt, max_e) = (amax(az, bz, cz), amax(u, v, w));
-            let g = |n: u32| L::splat(crate::math::gamma(n));
-            let delta_x = L::mul(g(5), L::add(max_xt, max_zt));
-            let delta_y = L::mul(g(5), L::add(max_yt, max_zt));
-            let delta_z = L::mul(g(3), max_zt);
-            let delta_e = L::mul(
-                L::splat(2.0),
-                L::add(
-                    L::add(
-                        L::mul(L::mul(g(2), max_xt), max_yt),
-                        L::mul(delta_y, max_xt),
-                    ),
-                    L::mul(delta_x, max_yt),
-                ),
-            );
-            let bound = L::mul(
-                L::splat(3.0),
-                L::add(
-                    L::add(L::mul(L::mul(g(3), max_e), max_zt), L::mul(delta_e, max_zt)),
-                    L::mul(delta_z, max_e),
-                ),
-            );
-            // Lanes inside the bound take the scalar path, which settles them in f64.
-            let ambiguous = check & !L::lt(bound, tss);
-            hit &= !ambiguous;
-            unsure |= ambiguous;
+impl Stack {
+    #[inline(always)]
+    fn push(&mut self, c: Child, m: Mask) {
+        self.e[self.sp] = (c, m);
+        self.sp += 1;
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(Child, Mask)> {
+        if self.sp == 0 {
+            return None;
         }
+        self.sp -= 1;
+        Some(self.e[self.sp])
+    }
+}
+
+/// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
+/// entry distance of each child's first lane.
+#[inline(always)]
+fn push_children<V: Vector<WIDTH>, const FAULT: u32>(
+    n: &Node,
+    p: &Prep<V>,
+    m: u32,
+    cull: V,
+    stack: &mut Stack,
+) {
+    let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask); 8];
+    let mut k = 0;
+    let mut near = [0.0; WIDTH];
+    for i in 0..n.count as usize {
+        let hit = m & slab(n, i, p, cull, &mut near);
         if hit != 0 {
-            let inv = L::div(L::splat(1.0), det);
-            let t = L::mul(ts, inv);
-            hit &= L::lt(t, tm);
-            L::store(t, &mut out[0]);
-            L::store(L::mul(v, inv), &mut out[1]);
-            L::store(L::mul(w, inv), &mut out[2]);
+            let key = near[hit.trailing_zeros() as usize];
+            let key = if FAULT & FAULT_FAR_FIRST != 0 {
+                -key
+            } else {
+                key
+            };
+            // Insertion by descending key: the nearest ends on top of the stack.
+            let mut j = k;
+            while j > 0 && keys[j - 1].0 < key {
+                keys[j] = keys[j - 1];
+                j -= 1;
+            }
+            keys[j] = (key, n.child[i], hit as Mask);
+            k += 1;
         }
     }
-    let mut rest = edge0 | unsure;
-    while rest != 0 {
-        let l = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        let r = Ray::new(prep.rays[l].origin, prep.rays[l].dir, tmax[l]);
-        if let Some(h) = tri.intersect(&r, &prep.wr[l])
-            && h.t < tmax[l]
-        {
-            out[0][l] = h.t;
-            out[1][l] = h.b1;
-            out[2][l] = h.b2;
-            hit |= 1 << l;
-        }
-    }
-    hit
-}
-
-/// Child visit order from the first active lane's direction along the axis that best
-/// separates the two child boxes (cheap front-to-back for coherent packets).
-#[inline(always)]
-fn near_first(tr: &PacketTracer, n: &Node, prep: &Prep, m: Mask) -> (u32, u32) {
-    let (a, b) = (&tr.nodes[n.first as usize], &tr.nodes[n.first as usize + 1]);
-    let mut axis = 0;
-    let mut best = -1.0f32;
-    for k in 0..3 {
-        let d = ((b.min[k] + b.max[k]) - (a.min[k] + a.max[k])).abs();
-        if d > best {
-            best = d;
-            axis = k;
-        }
-    }
-    let lane = m.trailing_zeros() as usize;
-    let d = prep.inv[axis][lane];
-    let a_lower = a.min[axis] + a.max[axis] <= b.min[axis] + b.max[axis];
-    if (d >= 0.0) == a_lower {
-        (n.first, n.first + 1)
-    } else {
-        (n.first + 1, n.first)
+    for &(_, c, hm) in &keys[..k] {
+        stack.push(c, hm);
     }
 }
 
-pub struct Closest<'a> {
+/// Closest hits so far, per lane.
+struct Bests {
+    t: [f32; WIDTH],
+    prim: [u32; WIDTH],
+    u: [f32; WIDTH],
+    v: [f32; WIDTH],
+    tmax: [f32; WIDTH],
+}
+
+impl Bests {
+    #[inline(always)]
+    fn get(&self, l: usize) -> Best {
+        Best {
+            t: self.t[l],
+            prim: self.prim[l],
+            u: self.u[l],
+            v: self.v[l],
+            tmax: self.tmax[l],
+        }
+    }
+    #[inline(always)]
+    fn put(&mut self, l: usize, b: &Best) {
+        (self.t[l], self.prim[l], self.u[l], self.v[l]) = (b.t, b.prim, b.u, b.v);
+    }
+    #[inline(always)]
+    fn offer(&mut self, l: usize, t: f32, prim: u32, u: f32, v: f32) {
+        let mut b = self.get(l);
+        b.offer(t, prim, u, v);
+        self.put(l, &b);
+    }
+    /// Per lane `min(tmax, best · CULL_SCALE)`: see [`Best::test_tmax`].
+    #[inline(always)]
+    fn test_tmax<V: Vector<WIDTH>>(&self) -> V {
+        V::load(&self.t)
+            .mul(V::splat(CULL_SCALE))
+            .min(V::load(&self.tmax))
+    }
+}
+
+pub struct Closest<'a, const FAULT: u32> {
     pub tr: &'a PacketTracer,
     pub rays: &'a RayPacket,
     pub active: LaneMask,
@@ -222,7 +244,7 @@ pub struct Closest<'a> {
     pub stats: &'a mut TraceStats,
 }
 
-impl Kernel for Closest<'_> {
+impl<const FAULT: u32> Kernel for Closest<'_, FAULT> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
@@ -233,117 +255,105 @@ impl Kernel for Closest<'_> {
             hits,
             stats,
         } = self;
-        let prep = Prep::new(rays);
-        let o = prep.o.map(|x| L::load(&x));
-        let inv = prep.inv.map(|x| L::load(&x));
-        let shear = prep.shear.map(|x| L::load(&x));
-        let mut best_t = rays.tmax;
-        let mut tv = L::load(&best_t);
+        let g = &*tr.geometry;
+        let p = Prep::<L::V>::new(rays, active);
+        let mut best = Bests {
+            t: rays.tmax,
+            prim: [crate::tracer::NO_HIT; WIDTH],
+            u: [0.0; WIDTH],
+            v: [0.0; WIDTH],
+            tmax: rays.tmax,
+        };
+        let mut stack = Stack {
+            e: [(Child::EMPTY, 0); STACK],
+            sp: 0,
+        };
+        stack.push(tr.wide.root, active);
         let mut out = [[0.0f32; WIDTH]; 3];
-        let mut stack = [(0u32, 0 as Mask); STACK];
-        stack[0] = (0, active);
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            let (ni, m_in) = stack[sp];
-            let n = tr.nodes[ni as usize];
-            stats.packet_nodes += 1;
-            stats.packet_lanes += m_in.count_ones() as u64;
-            let m = m_in & slab::<L>(&o, &inv, &n, tv);
-            if m == 0 {
-                continue;
-            }
+        while let Some((c, m)) = stack.pop() {
+            let m = m as u32;
             if m.count_ones() < HYBRID_LANES {
                 let mut rest = m;
                 while rest != 0 {
                     let l = rest.trailing_zeros() as usize;
                     rest &= rest - 1;
-                    let mut b = Best {
-                        t: best_t[l],
-                        prim: hits.prim[l],
-                        u: hits.u[l],
-                        v: hits.v[l],
-                    };
-                    single::closest(tr, &prep.rays[l], ni, &mut b, stats);
-                    (best_t[l], hits.prim[l], hits.u[l], hits.v[l]) = (b.t, b.prim, b.u, b.v);
+                    let mut b = best.get(l);
+                    let r = Ray1::new(&p.rays[l]);
+                    single::closest::<L, FAULT>(tr, &r, c, &mut b, stats, &mut |_| {});
+                    best.put(l, &b);
                 }
-                tv = L::load(&best_t);
                 continue;
             }
-            if n.count == 0 {
-                let (near, far) = near_first(tr, &n, &prep, m);
-                stack[sp] = (far, m);
-                stack[sp + 1] = (near, m);
-                sp += 2;
-                continue;
-            }
-            for slot in n.first..n.first + n.count {
-                let prim = tr.slot_prim[slot as usize];
-                let mut hit = match tr.geometry.sphere_index(prim) {
-                    None => triangle::<L>(
-                        &tr.geometry.triangles[prim as usize],
-                        &prep,
-                        &o,
-                        &shear,
-                        &best_t,
-                        m,
-                        &mut out,
-                    ),
-                    Some(_) => sphere_lanes(tr, &prep, prim, &best_t, m, &mut out),
-                };
-                while hit != 0 {
-                    let l = hit.trailing_zeros() as usize;
-                    hit &= hit - 1;
-                    (best_t[l], hits.prim[l], hits.u[l], hits.v[l]) =
-                        (out[0][l], prim, out[1][l], out[2][l]);
+            match c.kind() {
+                Kind::Inner(i) => {
+                    let n = &tr.wide.nodes[i as usize];
+                    stats.packet_nodes += 1;
+                    stats.packet_lanes += m.count_ones() as u64;
+                    let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
+                    push_children::<L::V, FAULT>(n, &p, m, cull, &mut stack);
                 }
+                Kind::Block(b, count) => {
+                    stats.leaves += 1;
+                    let blk = &tr.wide.blocks[b as usize];
+                    let tm = best.test_tmax::<L::V>();
+                    let mut tmv = [0.0; WIDTH];
+                    tm.store(&mut tmv);
+                    for slot in 0..count as usize {
+                        let s = p.sheared(blk, slot);
+                        let prim = blk.prim[slot];
+                        let (mut hit, mut rest) =
+                            leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
+                        while hit != 0 {
+                            let l = hit.trailing_zeros() as usize;
+                            hit &= hit - 1;
+                            best.offer(l, out[0][l], prim, out[1][l], out[2][l]);
+                        }
+                        while rest != 0 {
+                            let l = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            let r = Ray::new(p.rays[l].origin, p.rays[l].dir, tmv[l]);
+                            if let Some(h) = g.triangles[prim as usize].intersect(&r, &p.wr[l]) {
+                                best.offer(l, h.t, prim, h.b1, h.b2);
+                            }
+                        }
+                    }
+                }
+                Kind::Sphere(prim) => {
+                    stats.leaves += 1;
+                    let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
+                    let mut rest = m;
+                    while rest != 0 {
+                        let l = rest.trailing_zeros() as usize;
+                        rest &= rest - 1;
+                        let b = best.get(l);
+                        let r = Ray::new(p.rays[l].origin, p.rays[l].dir, b.test_tmax());
+                        if let Some(t) = sphere.intersect(&r) {
+                            best.offer(l, t, prim, 0.0, 0.0);
+                        }
+                    }
+                }
+                Kind::Empty => {}
             }
-            tv = L::load(&best_t);
         }
-        for ((t, &p), &b) in hits.t.iter_mut().zip(&hits.prim).zip(&best_t) {
-            *t = if p == crate::tracer::NO_HIT {
-                f32::INFINITY
-            } else {
-                b
-            };
+        for l in 0..WIDTH {
+            if best.prim[l] != crate::tracer::NO_HIT {
+                hits.t[l] = best.t[l];
+                hits.prim[l] = best.prim[l];
+                hits.u[l] = best.u[l];
+                hits.v[l] = best.v[l];
+            }
         }
     }
 }
 
-/// Spheres are few (lights, analytic shapes): tested per lane with the scalar routine.
-#[inline(always)]
-fn sphere_lanes(
-    tr: &PacketTracer,
-    prep: &Prep,
-    prim: u32,
-    tmax: &[f32; WIDTH],
-    m: Mask,
-    out: &mut [[f32; WIDTH]; 3],
-) -> Mask {
-    let mut hit = 0;
-    let mut rest = m;
-    while rest != 0 {
-        let l = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        let r = Ray::new(prep.rays[l].origin, prep.rays[l].dir, tmax[l]);
-        if let Some((t, u, v)) = prim_hit(tr, &r, &prep.wr[l], prim)
-            && t < tmax[l]
-        {
-            (out[0][l], out[1][l], out[2][l]) = (t, u, v);
-            hit |= 1 << l;
-        }
-    }
-    hit
-}
-
-pub struct Occluded<'a> {
+pub struct Occluded<'a, const FAULT: u32> {
     pub tr: &'a PacketTracer,
     pub rays: &'a RayPacket,
     pub active: LaneMask,
     pub stats: &'a mut TraceStats,
 }
 
-impl Kernel for Occluded<'_> {
+impl<const FAULT: u32> Kernel for Occluded<'_, FAULT> {
     type Out = LaneMask;
     #[inline(always)]
     fn run<L: Lanes>(self) -> LaneMask {
@@ -353,73 +363,86 @@ impl Kernel for Occluded<'_> {
             active,
             stats,
         } = self;
-        let prep = Prep::new(rays);
-        let o = prep.o.map(|x| L::load(&x));
-        let inv = prep.inv.map(|x| L::load(&x));
-        let shear = prep.shear.map(|x| L::load(&x));
-        let tmax = rays.tmax;
-        let tv = L::load(&tmax);
+        let g = &*tr.geometry;
+        let p = Prep::<L::V>::new(rays, active);
+        let tm = L::V::load(&rays.tmax);
+        let cull = tm.mul(L::V::splat(CULL_SCALE));
         let mut out = [[0.0f32; WIDTH]; 3];
         // Lanes still looking for an occluder; a lane retires at its first hit.
-        let mut alive = active;
-        let mut stack = [(0u32, 0 as Mask); STACK];
-        stack[0] = (0, active);
-        let mut sp = 1;
-        while sp > 0 && alive != 0 {
-            sp -= 1;
-            let (ni, m_in) = stack[sp];
-            let m_in = m_in & alive;
-            if m_in == 0 {
-                continue;
-            }
-            let n = tr.nodes[ni as usize];
-            stats.packet_nodes += 1;
-            stats.packet_lanes += m_in.count_ones() as u64;
-            let m = m_in & slab::<L>(&o, &inv, &n, tv);
+        let mut alive = active as u32;
+        let mut stack = Stack {
+            e: [(Child::EMPTY, 0); STACK],
+            sp: 0,
+        };
+        stack.push(tr.wide.root, active);
+        while let Some((c, m)) = stack.pop() {
+            let mut m = m as u32 & alive;
             if m == 0 {
                 continue;
             }
             if m.count_ones() < HYBRID_LANES {
-                let mut rest = m;
-                while rest != 0 {
-                    let l = rest.trailing_zeros() as usize;
-                    rest &= rest - 1;
-                    if single::occluded(tr, &prep.rays[l], ni, stats) {
+                while m != 0 {
+                    let l = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    let r = Ray1::new(&p.rays[l]);
+                    if single::occluded::<L, FAULT>(tr, &r, c, stats) {
                         alive &= !(1 << l);
                     }
                 }
-                continue;
-            }
-            if n.count == 0 {
-                // Any-hit needs no exact order; still near-first, as it finds occluders sooner.
-                let (near, far) = near_first(tr, &n, &prep, m);
-                stack[sp] = (far, m);
-                stack[sp + 1] = (near, m);
-                sp += 2;
-                continue;
-            }
-            let mut m = m;
-            for slot in n.first..n.first + n.count {
-                let prim = tr.slot_prim[slot as usize];
-                let hit = match tr.geometry.sphere_index(prim) {
-                    None => triangle::<L>(
-                        &tr.geometry.triangles[prim as usize],
-                        &prep,
-                        &o,
-                        &shear,
-                        &tmax,
-                        m,
-                        &mut out,
-                    ),
-                    Some(_) => sphere_lanes(tr, &prep, prim, &tmax, m, &mut out),
-                };
-                alive &= !hit;
-                m &= !hit;
-                if m == 0 {
+                if alive == 0 {
                     break;
                 }
+                continue;
+            }
+            match c.kind() {
+                Kind::Inner(i) => {
+                    let n = &tr.wide.nodes[i as usize];
+                    stats.packet_nodes += 1;
+                    stats.packet_lanes += m.count_ones() as u64;
+                    push_children::<L::V, FAULT>(n, &p, m, cull, &mut stack);
+                }
+                Kind::Block(b, count) => {
+                    stats.leaves += 1;
+                    let blk = &tr.wide.blocks[b as usize];
+                    for slot in 0..count as usize {
+                        let s = p.sheared(blk, slot);
+                        let prim = blk.prim[slot];
+                        let (mut occ, mut rest) =
+                            leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
+                        while rest != 0 {
+                            let l = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            if g.triangles[prim as usize]
+                                .intersect(&p.rays[l], &p.wr[l])
+                                .is_some_and(|h| h.t < p.rays[l].tmax)
+                            {
+                                occ |= 1 << l;
+                            }
+                        }
+                        m &= !occ;
+                        alive &= !occ;
+                        if m == 0 {
+                            break;
+                        }
+                    }
+                }
+                Kind::Sphere(prim) => {
+                    stats.leaves += 1;
+                    let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
+                    while m != 0 {
+                        let l = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        if sphere.intersect(&p.rays[l]).is_some() {
+                            alive &= !(1 << l);
+                        }
+                    }
+                }
+                Kind::Empty => {}
+            }
+            if alive == 0 {
+                break;
             }
         }
-        active & !alive
+        (active as u32 & !alive) as LaneMask
     }
 }
