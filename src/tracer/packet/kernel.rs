@@ -1,82 +1,172 @@
 //! The 16-ray packet kernels over the wide BVH, generic over [`Lanes`]: per visited node one
 //! 16-lane slab test per child for the active lanes, a (child, lane-mask) stack, children
 //! pushed far to near by the entry distance of their first active lane, and the watertight
-//! triangle test across lanes with a per-lane axis permutation. A node (or leaf) reached by
-//! few lanes is finished one ray at a time (Benthin et al. 2012).
+//! triangle test across lanes. A node (or leaf) reached by fewer than [`HYBRID_LANES`] lanes
+//! is finished one ray at a time (Benthin et al. 2012).
+//!
+//! Packet set-up is vectorised, and what the lanes share is used: a shared origin (camera
+//! rays) turns `box − origin` into scalar work, shared direction signs pick near/far planes
+//! without min/max, and a shared axis permutation (most coherent packets) drops the per-lane
+//! shuffles of the triangle test. Every variant computes the same values as the general one.
 
-use super::build::{Block, Child, Kind, Node};
-use super::leaf::{self, Sheared};
+use super::build::{Block, Child, Kind, MAX_ROW, Node};
+use super::leaf::{self, Out, Sheared};
 use super::{
-    Best, FAR_SCALE, FAULT_FAR_FIRST, HYBRID_LANES, PacketTracer, Ray1, STACK, TraceStats,
-    safe_inv, single,
+    Best, FAR_SCALE, FAULT_FAR_FIRST, HYBRID_LANES, PacketTracer, Ray1, STACK, TraceStats, single,
 };
 use crate::geometry::Ray;
-use crate::geometry::triangle::WatertightRay;
 use crate::simd::{Kernel, Lanes, Mask, Vector, WIDTH};
-use crate::tracer::{CULL_SCALE, HitPacket, LaneMask, RayPacket};
+use crate::tracer::{CULL_SCALE, HitPacket, LaneMask, NO_HIT, RayPacket};
+use std::mem::MaybeUninit;
 
-/// Per-packet constants.
+const FULL: u32 = (1 << WIDTH) - 1;
+
+/// Per-packet constants, computed across lanes with the scalar set-up's operations.
 struct Prep<V> {
     o: [V; 3],
     inv: [V; 3],
     shear: [V; 3],
     /// `kmask[j][c]`: lanes whose j-th permuted axis (kx, ky, kz) is c (c = 0, 1; else 2).
     kmask: [[u32; 2]; 3],
-    /// The permutation when every lane shares it (a shared direction, most camera tiles).
+    /// The permutation when every active lane shares it.
     uniform: Option<[usize; 3]>,
-    wr: [WatertightRay; WIDTH],
-    rays: [Ray; WIDTH],
+    /// The origin when every active lane shares it (bit for bit).
+    origin: [f32; 3],
+    /// Near-plane row per axis when every active lane's direction has the same sign there.
+    near_row: [usize; 3],
+    lanes: Lanes16,
+}
+
+/// Lane `l`'s j-th permuted axis.
+#[inline(always)]
+fn axis(kmask: &[[u32; 2]; 3], j: usize, l: usize) -> usize {
+    if kmask[j][0] >> l & 1 != 0 {
+        0
+    } else if kmask[j][1] >> l & 1 != 0 {
+        1
+    } else {
+        2
+    }
+}
+
+/// Lane arrays of the set-up, for the single-ray tail.
+struct Lanes16 {
+    inv: [[f32; WIDTH]; 3],
+    shear: [[f32; WIDTH]; 3],
+}
+
+/// Which shared quantities a packet has (the kernel variant).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Shape {
+    /// Shared origin and direction signs.
+    Origin,
+    /// Shared direction signs.
+    Signs,
+    General,
 }
 
 impl<V: Vector<WIDTH>> Prep<V> {
     #[inline(always)]
-    fn new(p: &RayPacket, active: LaneMask) -> Self {
-        let mut shear = [[0.0; WIDTH]; 3];
-        let mut kmask = [[0u32; 2]; 3];
-        let mut wr = [WatertightRay::new(glam::Vec3::Z); WIDTH];
-        let mut rays = [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z, 0.0); WIDTH];
-        let mut uniform = None;
-        let mut mixed = false;
-        for l in 0..WIDTH {
-            let ray = p.get(l);
-            // Inactive lanes may hold a zero direction; their constants are never used.
-            let w = if active & (1 << l) == 0 {
-                WatertightRay::new(glam::Vec3::Z)
-            } else {
-                let w = WatertightRay::new(ray.dir);
-                match uniform {
-                    None => uniform = Some(w.axes()),
-                    Some(k) => mixed |= k != w.axes(),
-                }
-                w
-            };
-            let (k, s) = (w.axes(), w.shear());
-            for j in 0..3 {
-                shear[j][l] = s[j];
-                for c in 0..2 {
-                    if k[j] == c {
-                        kmask[j][c] |= 1 << l;
-                    }
-                }
-            }
-            wr[l] = w;
-            rays[l] = ray;
+    fn new(p: &RayPacket, active: LaneMask) -> (Self, Shape) {
+        let active = active as u32;
+        let d = [V::load(&p.dx), V::load(&p.dy), V::load(&p.dz)];
+        let (one, zero) = (V::splat(1.0), V::splat(0.0));
+        // safe_inv across lanes.
+        let tiny = V::splat(1e-30);
+        let big = 1.0f32 / 1e-30;
+        let (pos_big, neg_big) = (V::splat(big), V::splat(-big));
+        let mut inv = [zero; 3];
+        let mut inv_a = [[0.0; WIDTH]; 3];
+        for a in 0..3 {
+            let small = d[a].abs().lt(tiny);
+            let huge = V::select(d[a].sign(), neg_big, pos_big);
+            inv[a] = V::select(small, huge, one.div(d[a]));
+            inv[a].store(&mut inv_a[a]);
         }
-        let mut inv = [[0.0; WIDTH]; 3];
-        for l in 0..WIDTH {
-            inv[0][l] = safe_inv(p.dx[l]);
-            inv[1][l] = safe_inv(p.dy[l]);
-            inv[2][l] = safe_inv(p.dz[l]);
+        // WatertightRay::new across lanes: kz = the dominant axis, (kx, ky) the next two,
+        // swapped for a negative d[kz].
+        let ab = [d[0].abs(), d[1].abs(), d[2].abs()];
+        let m0 = ab[1].lt(ab[0]) & ab[2].lt(ab[0]);
+        let m1 = !ab[1].lt(ab[0]) & ab[2].lt(ab[1]) & FULL;
+        let m2 = !(m0 | m1) & FULL;
+        let dkz = V::select(m0, d[0], V::select(m1, d[1], d[2]));
+        let neg = dkz.lt(zero);
+        let pos = !neg & FULL;
+        let kx = [(m2 & pos) | (m1 & neg), (m0 & pos) | (m2 & neg)];
+        let ky = [(m1 & pos) | (m2 & neg), (m2 & pos) | (m0 & neg)];
+        let dkx = V::select(kx[0], d[0], V::select(kx[1], d[1], d[2]));
+        let dky = V::select(ky[0], d[0], V::select(ky[1], d[1], d[2]));
+        let shear = [dkx.div(dkz), dky.div(dkz), one.div(dkz)];
+        let mut shear_a = [[0.0; WIDTH]; 3];
+        for j in 0..3 {
+            shear[j].store(&mut shear_a[j]);
         }
-        Prep {
-            o: [V::load(&p.ox), V::load(&p.oy), V::load(&p.oz)],
-            inv: [V::load(&inv[0]), V::load(&inv[1]), V::load(&inv[2])],
-            shear: [V::load(&shear[0]), V::load(&shear[1]), V::load(&shear[2])],
-            kmask,
-            uniform: if mixed { None } else { uniform },
-            wr,
-            rays,
+        let kmask = [kx, ky, [m0, m1]];
+        let same = |m: u32| m & active == active || m & active == 0;
+        let uniform = (same(m0) && same(m1) && same(m2) && same(neg)).then(|| {
+            let l = active.trailing_zeros() as usize;
+            [axis(&kmask, 0, l), axis(&kmask, 1, l), axis(&kmask, 2, l)]
+        });
+        let first = active.trailing_zeros() as usize;
+        let origin = [p.ox[first], p.oy[first], p.oz[first]];
+        let mut shared = true;
+        let mut rest = active;
+        while rest != 0 {
+            let l = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            shared &= p.ox[l].to_bits() == origin[0].to_bits()
+                && p.oy[l].to_bits() == origin[1].to_bits()
+                && p.oz[l].to_bits() == origin[2].to_bits();
         }
+        let mut near_row = [0; 3];
+        let mut signs = true;
+        for a in 0..3 {
+            let s = inv[a].sign() & active;
+            signs &= s == 0 || s == active;
+            near_row[a] = if s != 0 { a + MAX_ROW } else { a };
+        }
+        let shape = match (shared, signs) {
+            (true, true) => Shape::Origin,
+            (_, true) => Shape::Signs,
+            _ => Shape::General,
+        };
+        (
+            Prep {
+                o: [V::load(&p.ox), V::load(&p.oy), V::load(&p.oz)],
+                inv,
+                shear,
+                kmask,
+                uniform,
+                origin,
+                near_row,
+                lanes: Lanes16 {
+                    inv: inv_a,
+                    shear: shear_a,
+                },
+            },
+            shape,
+        )
+    }
+
+    /// Lane `l` as a single ray, from the packet's set-up (no recomputation).
+    #[inline(always)]
+    fn ray1(&self, p: &RayPacket, l: usize) -> Ray1 {
+        let k = [
+            axis(&self.kmask, 0, l),
+            axis(&self.kmask, 1, l),
+            axis(&self.kmask, 2, l),
+        ];
+        let s = [
+            self.lanes.shear[0][l],
+            self.lanes.shear[1][l],
+            self.lanes.shear[2][l],
+        ];
+        let inv = [
+            self.lanes.inv[0][l],
+            self.lanes.inv[1][l],
+            self.lanes.inv[2][l],
+        ];
+        Ray1::from_parts(p.get(l), inv, k, s)
     }
 
     /// Per lane, component `k[j]` of (x, y, z).
@@ -91,9 +181,9 @@ impl<V: Vector<WIDTH>> Prep<V> {
         }
     }
 
-    /// One triangle in every lane's sheared space.
+    /// Triangle `slot` of a block in every lane's sheared space.
     #[inline(always)]
-    fn sheared(&self, blk: &Block, slot: usize) -> Sheared<V> {
+    fn sheared<const ORIGIN: bool>(&self, blk: &Block, slot: usize) -> Sheared<V> {
         let z = V::splat(0.0);
         let mut s = Sheared {
             x: [z; 3],
@@ -102,11 +192,19 @@ impl<V: Vector<WIDTH>> Prep<V> {
         };
         for vtx in 0..3 {
             let v = &blk.v[vtx];
-            let p = [
-                V::splat(v[0][slot]).sub(self.o[0]),
-                V::splat(v[1][slot]).sub(self.o[1]),
-                V::splat(v[2][slot]).sub(self.o[2]),
-            ];
+            let p = if ORIGIN {
+                [
+                    V::splat(v[0][slot] - self.origin[0]),
+                    V::splat(v[1][slot] - self.origin[1]),
+                    V::splat(v[2][slot] - self.origin[2]),
+                ]
+            } else {
+                [
+                    V::splat(v[0][slot]).sub(self.o[0]),
+                    V::splat(v[1][slot]).sub(self.o[1]),
+                    V::splat(v[2][slot]).sub(self.o[2]),
+                ]
+            };
             let (px, py, pz) = (self.pick(0, &p), self.pick(1, &p), self.pick(2, &p));
             s.x[vtx] = px.sub(self.shear[0].mul(pz));
             s.y[vtx] = py.sub(self.shear[1].mul(pz));
@@ -114,95 +212,135 @@ impl<V: Vector<WIDTH>> Prep<V> {
         }
         s
     }
-}
 
-/// Lanes whose ray meets child `i`'s box within (0, cull); entry distances in `near_out`.
-#[inline(always)]
-fn slab<V: Vector<WIDTH>>(
-    n: &Node,
-    i: usize,
-    p: &Prep<V>,
-    cull: V,
-    near_out: &mut [f32; WIDTH],
-) -> u32 {
-    let mut near = V::splat(0.0);
-    let mut far = V::splat(f32::INFINITY);
-    for a in 0..3 {
-        let t0 = V::splat(n.b[a][i]).sub(p.o[a]).mul(p.inv[a]);
-        let t1 = V::splat(n.b[3 + a][i]).sub(p.o[a]).mul(p.inv[a]);
-        near = t0.min(t1).max(near);
-        far = t0.max(t1).min(far);
+    /// Lanes whose ray meets child `i`'s box within (0, cull); entry distances in `near_out`.
+    #[inline(always)]
+    fn slab<const ORIGIN: bool, const SIGNS: bool>(
+        &self,
+        n: &Node,
+        i: usize,
+        cull: V,
+        near_out: &mut [f32; WIDTH],
+    ) -> u32 {
+        let mut near = V::splat(0.0);
+        let mut far = V::splat(f32::INFINITY);
+        for a in 0..3 {
+            let (lo, hi) = if SIGNS {
+                let lo = self.near_row[a];
+                (
+                    lo,
+                    if lo < MAX_ROW {
+                        lo + MAX_ROW
+                    } else {
+                        lo - MAX_ROW
+                    },
+                )
+            } else {
+                (a, a + MAX_ROW)
+            };
+            let (b0, b1) = if ORIGIN {
+                (
+                    V::splat(n.b[lo][i] - self.origin[a]),
+                    V::splat(n.b[hi][i] - self.origin[a]),
+                )
+            } else {
+                (
+                    V::splat(n.b[lo][i]).sub(self.o[a]),
+                    V::splat(n.b[hi][i]).sub(self.o[a]),
+                )
+            };
+            let (t0, t1) = (b0.mul(self.inv[a]), b1.mul(self.inv[a]));
+            if SIGNS {
+                near = t0.max(near);
+                far = t1.min(far);
+            } else {
+                near = t0.min(t1).max(near);
+                far = t0.max(t1).min(far);
+            }
+        }
+        let far = far.mul(V::splat(FAR_SCALE)).min(cull);
+        near.store(near_out);
+        near.le(far)
     }
-    let far = far.mul(V::splat(FAR_SCALE)).min(cull);
-    near.store(near_out);
-    near.le(far)
+
+    /// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
+    /// entry distance of each child's first lane.
+    #[inline(always)]
+    fn push_children<const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+        &self,
+        n: &Node,
+        m: u32,
+        cull: V,
+        stack: &mut Stack,
+    ) {
+        let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask); 8];
+        let mut k = 0;
+        let mut near = [0.0; WIDTH];
+        for i in 0..n.count as usize {
+            let hit = m & self.slab::<ORIGIN, SIGNS>(n, i, cull, &mut near);
+            if hit != 0 {
+                let key = near[hit.trailing_zeros() as usize];
+                let key = if FAULT & FAULT_FAR_FIRST != 0 {
+                    -key
+                } else {
+                    key
+                };
+                // Insertion by descending key: the nearest ends on top of the stack.
+                let mut j = k;
+                while j > 0 && keys[j - 1].0 < key {
+                    keys[j] = keys[j - 1];
+                    j -= 1;
+                }
+                keys[j] = (key, n.child[i], hit as Mask);
+                k += 1;
+            }
+        }
+        for &(_, c, hm) in &keys[..k] {
+            stack.push(c, hm);
+        }
+    }
 }
 
-/// A (child, lane-mask) stack.
+/// A (child, lane-mask) stack without initialising its storage.
 struct Stack {
-    e: [(Child, Mask); STACK],
+    e: [MaybeUninit<(Child, Mask)>; STACK],
     sp: usize,
 }
 
 impl Stack {
     #[inline(always)]
+    fn new(root: Child, active: LaneMask) -> Self {
+        let mut s = Stack {
+            e: [const { MaybeUninit::uninit() }; STACK],
+            sp: 0,
+        };
+        s.push(root, active);
+        s
+    }
+    #[inline(always)]
     fn push(&mut self, c: Child, m: Mask) {
-        self.e[self.sp] = (c, m);
+        // The build bounds depth · BRANCH by STACK; indexing checks anyway.
+        self.e[self.sp] = MaybeUninit::new((c, m));
         self.sp += 1;
     }
     #[inline(always)]
-    fn pop(&mut self) -> Option<(Child, Mask)> {
+    fn pop(&mut self) -> Option<(Child, u32)> {
         if self.sp == 0 {
             return None;
         }
         self.sp -= 1;
-        Some(self.e[self.sp])
-    }
-}
-
-/// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
-/// entry distance of each child's first lane.
-#[inline(always)]
-fn push_children<V: Vector<WIDTH>, const FAULT: u32>(
-    n: &Node,
-    p: &Prep<V>,
-    m: u32,
-    cull: V,
-    stack: &mut Stack,
-) {
-    let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask); 8];
-    let mut k = 0;
-    let mut near = [0.0; WIDTH];
-    for i in 0..n.count as usize {
-        let hit = m & slab(n, i, p, cull, &mut near);
-        if hit != 0 {
-            let key = near[hit.trailing_zeros() as usize];
-            let key = if FAULT & FAULT_FAR_FIRST != 0 {
-                -key
-            } else {
-                key
-            };
-            // Insertion by descending key: the nearest ends on top of the stack.
-            let mut j = k;
-            while j > 0 && keys[j - 1].0 < key {
-                keys[j] = keys[j - 1];
-                j -= 1;
-            }
-            keys[j] = (key, n.child[i], hit as Mask);
-            k += 1;
-        }
-    }
-    for &(_, c, hm) in &keys[..k] {
-        stack.push(c, hm);
+        // SAFETY: entries below sp were written by push.
+        let (c, m) = unsafe { self.e[self.sp].assume_init() };
+        Some((c, m as u32))
     }
 }
 
 /// Closest hits so far, per lane.
 struct Bests {
     t: [f32; WIDTH],
-    prim: [u32; WIDTH],
     u: [f32; WIDTH],
     v: [f32; WIDTH],
+    prim: [u32; WIDTH],
     tmax: [f32; WIDTH],
 }
 
@@ -217,16 +355,40 @@ impl Bests {
             tmax: self.tmax[l],
         }
     }
+
     #[inline(always)]
     fn put(&mut self, l: usize, b: &Best) {
         (self.t[l], self.prim[l], self.u[l], self.v[l]) = (b.t, b.prim, b.u, b.v);
     }
+
+    /// [`Best::offer`] for the hit lanes of one triangle (their t is below the tmax they
+    /// were tested with, which is at most the ray's).
     #[inline(always)]
-    fn offer(&mut self, l: usize, t: f32, prim: u32, u: f32, v: f32) {
-        let mut b = self.get(l);
-        b.offer(t, prim, u, v);
-        self.put(l, &b);
+    fn offer<V: Vector<WIDTH>>(&mut self, hit: u32, out: &Out<WIDTH>, prim: u32) {
+        let t = V::load(&out[0]);
+        let bt = V::load(&self.t);
+        let mut take = hit & t.lt(bt);
+        let mut tie = hit & t.eq(bt);
+        while tie != 0 {
+            let l = tie.trailing_zeros() as usize;
+            tie &= tie - 1;
+            if prim < self.prim[l] {
+                take |= 1 << l;
+            }
+        }
+        if take == 0 {
+            return;
+        }
+        V::select(take, t, bt).store(&mut self.t);
+        V::select(take, V::load(&out[1]), V::load(&self.u)).store(&mut self.u);
+        V::select(take, V::load(&out[2]), V::load(&self.v)).store(&mut self.v);
+        while take != 0 {
+            let l = take.trailing_zeros() as usize;
+            take &= take - 1;
+            self.prim[l] = prim;
+        }
     }
+
     /// Per lane `min(tmax, best · CULL_SCALE)`: see [`Best::test_tmax`].
     #[inline(always)]
     fn test_tmax<V: Vector<WIDTH>>(&self) -> V {
@@ -248,100 +410,116 @@ impl<const FAULT: u32> Kernel for Closest<'_, FAULT> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
-        let Closest {
-            tr,
-            rays,
-            active,
-            hits,
-            stats,
-        } = self;
-        let g = &*tr.geometry;
-        let p = Prep::<L::V>::new(rays, active);
+        let (p, shape) = Prep::<L::V>::new(self.rays, self.active);
         let mut best = Bests {
-            t: rays.tmax,
-            prim: [crate::tracer::NO_HIT; WIDTH],
+            t: self.rays.tmax,
             u: [0.0; WIDTH],
             v: [0.0; WIDTH],
-            tmax: rays.tmax,
+            prim: [NO_HIT; WIDTH],
+            tmax: self.rays.tmax,
         };
-        let mut stack = Stack {
-            e: [(Child::EMPTY, 0); STACK],
-            sp: 0,
-        };
-        stack.push(tr.wide.root, active);
-        let mut out = [[0.0f32; WIDTH]; 3];
-        while let Some((c, m)) = stack.pop() {
-            let m = m as u32;
-            if m.count_ones() < HYBRID_LANES {
-                let mut rest = m;
-                while rest != 0 {
-                    let l = rest.trailing_zeros() as usize;
-                    rest &= rest - 1;
-                    let mut b = best.get(l);
-                    let r = Ray1::new(&p.rays[l]);
-                    single::closest::<L, FAULT>(tr, &r, c, &mut b, stats, &mut |_| {});
-                    best.put(l, &b);
-                }
-                continue;
+        let (tr, rays, active, stats) = (self.tr, self.rays, self.active, self.stats);
+        match shape {
+            Shape::Origin => {
+                closest::<L, FAULT, true, true>(tr, &p, rays, active, &mut best, stats)
             }
-            match c.kind() {
-                Kind::Inner(i) => {
-                    let n = &tr.wide.nodes[i as usize];
-                    stats.packet_nodes += 1;
-                    stats.packet_lanes += m.count_ones() as u64;
-                    let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                    push_children::<L::V, FAULT>(n, &p, m, cull, &mut stack);
-                }
-                Kind::Block(b, count) => {
-                    stats.leaves += 1;
-                    let blk = &tr.wide.blocks[b as usize];
-                    let tm = best.test_tmax::<L::V>();
-                    let mut tmv = [0.0; WIDTH];
-                    tm.store(&mut tmv);
-                    for slot in 0..count as usize {
-                        let s = p.sheared(blk, slot);
-                        let prim = blk.prim[slot];
-                        let (mut hit, mut rest) =
-                            leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
-                        while hit != 0 {
-                            let l = hit.trailing_zeros() as usize;
-                            hit &= hit - 1;
-                            best.offer(l, out[0][l], prim, out[1][l], out[2][l]);
-                        }
-                        while rest != 0 {
-                            let l = rest.trailing_zeros() as usize;
-                            rest &= rest - 1;
-                            let r = Ray::new(p.rays[l].origin, p.rays[l].dir, tmv[l]);
-                            if let Some(h) = g.triangles[prim as usize].intersect(&r, &p.wr[l]) {
-                                best.offer(l, h.t, prim, h.b1, h.b2);
-                            }
-                        }
-                    }
-                }
-                Kind::Sphere(prim) => {
-                    stats.leaves += 1;
-                    let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
-                    let mut rest = m;
-                    while rest != 0 {
-                        let l = rest.trailing_zeros() as usize;
-                        rest &= rest - 1;
-                        let b = best.get(l);
-                        let r = Ray::new(p.rays[l].origin, p.rays[l].dir, b.test_tmax());
-                        if let Some(t) = sphere.intersect(&r) {
-                            best.offer(l, t, prim, 0.0, 0.0);
-                        }
-                    }
-                }
-                Kind::Empty => {}
+            Shape::Signs => {
+                closest::<L, FAULT, false, true>(tr, &p, rays, active, &mut best, stats)
+            }
+            Shape::General => {
+                closest::<L, FAULT, false, false>(tr, &p, rays, active, &mut best, stats)
             }
         }
+        let hits = self.hits;
         for l in 0..WIDTH {
-            if best.prim[l] != crate::tracer::NO_HIT {
+            if best.prim[l] != NO_HIT {
                 hits.t[l] = best.t[l];
                 hits.prim[l] = best.prim[l];
                 hits.u[l] = best.u[l];
                 hits.v[l] = best.v[l];
             }
+        }
+    }
+}
+
+#[inline(always)]
+fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    tr: &PacketTracer,
+    p: &Prep<L::V>,
+    rays: &RayPacket,
+    active: LaneMask,
+    best: &mut Bests,
+    stats: &mut TraceStats,
+) {
+    let g = &*tr.geometry;
+    let mut stack = Stack::new(tr.wide.root, active);
+    let mut out = [[0.0f32; WIDTH]; 3];
+    while let Some((c, m)) = stack.pop() {
+        if m.count_ones() < HYBRID_LANES {
+            let mut rest = m;
+            while rest != 0 {
+                let l = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let mut b = best.get(l);
+                let r = p.ray1(rays, l);
+                single::closest::<L, FAULT>(tr, &r, c, &mut b, stats, &mut |_| {});
+                best.put(l, &b);
+            }
+            continue;
+        }
+        match c.kind() {
+            Kind::Inner(i) => {
+                let n = &tr.wide.nodes[i as usize];
+                stats.packet_nodes += 1;
+                stats.packet_lanes += m.count_ones() as u64;
+                let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
+                p.push_children::<FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+            }
+            Kind::Block(b, count) => {
+                stats.leaves += 1;
+                let blk = &tr.wide.blocks[b as usize];
+                let tm = best.test_tmax::<L::V>();
+                for slot in 0..count as usize {
+                    let s = p.sheared::<ORIGIN>(blk, slot);
+                    let prim = blk.prim[slot];
+                    let (hit, mut rest) =
+                        leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
+                    if hit != 0 {
+                        best.offer::<L::V>(hit, &out, prim);
+                    }
+                    if rest != 0 {
+                        let mut tmv = [0.0; WIDTH];
+                        tm.store(&mut tmv);
+                        while rest != 0 {
+                            let l = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            let r = p.ray1(rays, l);
+                            let ray = Ray::new(r.ray.origin, r.ray.dir, tmv[l]);
+                            if let Some(h) = g.triangles[prim as usize].intersect(&ray, &r.wr) {
+                                let mut b = best.get(l);
+                                b.offer(h.t, prim, h.b1, h.b2);
+                                best.put(l, &b);
+                            }
+                        }
+                    }
+                }
+            }
+            Kind::Sphere(prim) => {
+                stats.leaves += 1;
+                let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
+                let mut rest = m;
+                while rest != 0 {
+                    let l = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    let mut b = best.get(l);
+                    let r = rays.get(l);
+                    if let Some(t) = sphere.intersect(&Ray::new(r.origin, r.dir, b.test_tmax())) {
+                        b.offer(t, prim, 0.0, 0.0);
+                        best.put(l, &b);
+                    }
+                }
+            }
+            Kind::Empty => {}
         }
     }
 }
@@ -357,64 +535,67 @@ impl<const FAULT: u32> Kernel for Occluded<'_, FAULT> {
     type Out = LaneMask;
     #[inline(always)]
     fn run<L: Lanes>(self) -> LaneMask {
-        let Occluded {
-            tr,
-            rays,
-            active,
-            stats,
-        } = self;
-        let g = &*tr.geometry;
-        let p = Prep::<L::V>::new(rays, active);
-        let tm = L::V::load(&rays.tmax);
-        let cull = tm.mul(L::V::splat(CULL_SCALE));
-        let mut out = [[0.0f32; WIDTH]; 3];
-        // Lanes still looking for an occluder; a lane retires at its first hit.
-        let mut alive = active as u32;
-        let mut stack = Stack {
-            e: [(Child::EMPTY, 0); STACK],
-            sp: 0,
-        };
-        stack.push(tr.wide.root, active);
-        while let Some((c, m)) = stack.pop() {
-            let mut m = m as u32 & alive;
-            if m == 0 {
-                continue;
-            }
-            if m.count_ones() < HYBRID_LANES {
-                while m != 0 {
-                    let l = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let r = Ray1::new(&p.rays[l]);
-                    if single::occluded::<L, FAULT>(tr, &r, c, stats) {
-                        alive &= !(1 << l);
-                    }
+        let (p, shape) = Prep::<L::V>::new(self.rays, self.active);
+        let (tr, rays, active, stats) = (self.tr, self.rays, self.active, self.stats);
+        match shape {
+            Shape::Origin => occluded::<L, FAULT, true, true>(tr, &p, rays, active, stats),
+            Shape::Signs => occluded::<L, FAULT, false, true>(tr, &p, rays, active, stats),
+            Shape::General => occluded::<L, FAULT, false, false>(tr, &p, rays, active, stats),
+        }
+    }
+}
+
+#[inline(always)]
+fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    tr: &PacketTracer,
+    p: &Prep<L::V>,
+    rays: &RayPacket,
+    active: LaneMask,
+    stats: &mut TraceStats,
+) -> LaneMask {
+    let g = &*tr.geometry;
+    let tm = L::V::load(&rays.tmax);
+    let cull = tm.mul(L::V::splat(CULL_SCALE));
+    let mut out = [[0.0f32; WIDTH]; 3];
+    // Lanes still looking for an occluder; a lane retires at its first hit.
+    let mut alive = active as u32;
+    let mut stack = Stack::new(tr.wide.root, active);
+    while let Some((c, m)) = stack.pop() {
+        let mut m = m & alive;
+        if m == 0 {
+            continue;
+        }
+        if m.count_ones() < HYBRID_LANES {
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if single::occluded::<L, FAULT>(tr, &p.ray1(rays, l), c, stats) {
+                    alive &= !(1 << l);
                 }
-                if alive == 0 {
-                    break;
-                }
-                continue;
             }
+        } else {
             match c.kind() {
                 Kind::Inner(i) => {
                     let n = &tr.wide.nodes[i as usize];
                     stats.packet_nodes += 1;
                     stats.packet_lanes += m.count_ones() as u64;
-                    push_children::<L::V, FAULT>(n, &p, m, cull, &mut stack);
+                    p.push_children::<FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
                 }
                 Kind::Block(b, count) => {
                     stats.leaves += 1;
                     let blk = &tr.wide.blocks[b as usize];
                     for slot in 0..count as usize {
-                        let s = p.sheared(blk, slot);
+                        let s = p.sheared::<ORIGIN>(blk, slot);
                         let prim = blk.prim[slot];
                         let (mut occ, mut rest) =
                             leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
                         while rest != 0 {
                             let l = rest.trailing_zeros() as usize;
                             rest &= rest - 1;
+                            let r = p.ray1(rays, l);
                             if g.triangles[prim as usize]
-                                .intersect(&p.rays[l], &p.wr[l])
-                                .is_some_and(|h| h.t < p.rays[l].tmax)
+                                .intersect(&r.ray, &r.wr)
+                                .is_some_and(|h| h.t < r.ray.tmax)
                             {
                                 occ |= 1 << l;
                             }
@@ -432,17 +613,17 @@ impl<const FAULT: u32> Kernel for Occluded<'_, FAULT> {
                     while m != 0 {
                         let l = m.trailing_zeros() as usize;
                         m &= m - 1;
-                        if sphere.intersect(&p.rays[l]).is_some() {
+                        if sphere.intersect(&rays.get(l)).is_some() {
                             alive &= !(1 << l);
                         }
                     }
                 }
                 Kind::Empty => {}
             }
-            if alive == 0 {
-                break;
-            }
         }
-        (active as u32 & !alive) as LaneMask
+        if alive == 0 {
+            break;
+        }
     }
+    (active as u32 & !alive) as LaneMask
 }

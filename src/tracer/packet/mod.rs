@@ -138,22 +138,34 @@ pub struct Ray1 {
 impl Ray1 {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let inv = ray.dir.to_array().map(safe_inv);
-        let wr = WatertightRay::new(ray.dir);
+        let d = ray.dir;
+        let wr = WatertightRay::new(d);
+        Self::from_parts(
+            *ray,
+            [safe_inv(d.x), safe_inv(d.y), safe_inv(d.z)],
+            wr.axes(),
+            wr.shear(),
+        )
+    }
+
+    /// From constants a packet set-up computed (the same values as [`Self::new`]).
+    #[inline(always)]
+    pub fn from_parts(ray: Ray, inv: [f32; 3], k: [usize; 3], s: [f32; 3]) -> Self {
+        let row = |a: usize| {
+            if inv[a].is_sign_negative() {
+                a + build::MAX_ROW
+            } else {
+                a
+            }
+        };
         Ray1 {
-            ray: *ray,
+            ray,
             o: ray.origin.to_array(),
             inv,
-            near: std::array::from_fn(|a| {
-                if inv[a].is_sign_negative() {
-                    a + build::MAX_ROW
-                } else {
-                    a
-                }
-            }),
-            wr,
-            k: wr.axes(),
-            s: wr.shear(),
+            near: [row(0), row(1), row(2)],
+            wr: WatertightRay::from_parts(k, s),
+            k,
+            s,
         }
     }
 }
