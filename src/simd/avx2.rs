@@ -91,6 +91,24 @@ impl Vector<NARROW> for Y {
     fn select(m: u32, a: Self, b: Self) -> Self {
         unsafe { Y(_mm256_blendv_ps(b.0, a.0, expand(m))) }
     }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        unsafe {
+            let v = _mm256_min_ps(self.0, _mm256_permute2f128_ps::<1>(self.0, self.0));
+            let v = _mm256_min_ps(v, _mm256_shuffle_ps::<0b0100_1110>(v, v));
+            let v = _mm256_min_ps(v, _mm256_shuffle_ps::<0b1011_0001>(v, v));
+            _mm256_cvtss_f32(v)
+        }
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        unsafe {
+            let v = _mm256_max_ps(self.0, _mm256_permute2f128_ps::<1>(self.0, self.0));
+            let v = _mm256_max_ps(v, _mm256_shuffle_ps::<0b0100_1110>(v, v));
+            let v = _mm256_max_ps(v, _mm256_shuffle_ps::<0b1011_0001>(v, v));
+            _mm256_cvtss_f32(v)
+        }
+    }
 }
 
 macro_rules! both {
@@ -150,5 +168,13 @@ impl Vector<WIDTH> for Y2 {
     #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
         Y2(Y::select(m & 0xff, a.0, b.0), Y::select(m >> 8, a.1, b.1))
+    }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        self.0.min(self.1).reduce_min()
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        self.0.max(self.1).reduce_max()
     }
 }

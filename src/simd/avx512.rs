@@ -80,6 +80,14 @@ impl Vector<WIDTH> for Z {
         // mask_blend takes the second operand where the bit is set.
         unsafe { Z(_mm512_mask_blend_ps(m as __mmask16, b.0, a.0)) }
     }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        unsafe { _mm512_reduce_min_ps(self.0) }
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        unsafe { _mm512_reduce_max_ps(self.0) }
+    }
 }
 
 /// Sign bits of 16 lanes (avx512f has no movmskps for zmm: compare as integers against 0).

@@ -46,6 +46,10 @@ pub trait Vector<const N: usize>: Copy {
     fn sign(self) -> u32;
     /// Lane i = `a` where bit i of `m` is set, else `b`.
     fn select(m: u32, a: Self, b: Self) -> Self;
+    /// The smallest lane (for NaN-free lanes the result does not depend on the order).
+    fn reduce_min(self) -> f32;
+    /// The largest lane (likewise).
+    fn reduce_max(self) -> f32;
 }
 
 /// One ISA's vector types. A zero-sized type, so a kernel names its ISA once.
@@ -99,6 +103,8 @@ mod tests {
             x.abs(),
             V::select(0b1010_0101_1100_0011 & ((1u64 << N) - 1) as u32, x, y),
             V::splat(a[1]),
+            V::splat(x.reduce_min()),
+            V::splat(y.reduce_max()),
         ];
         let out = vs
             .iter()
@@ -141,6 +147,7 @@ mod tests {
         let a: [f32; WIDTH] = std::array::from_fn(|i| match i {
             3 => -0.0,
             5 => f32::INFINITY,
+            6 => -9.5,
             _ => (i as f32 - 7.5) * 0.37,
         });
         let b: [f32; WIDTH] = std::array::from_fn(|i| {
@@ -153,6 +160,7 @@ mod tests {
         let want = run(Isa::Portable, Probe(a, b));
         assert_eq!(want[0].1[2].count_ones(), 6);
         assert_eq!(want[0].1[3] & 0b1000, 0b1000, "-0.0 has its sign bit");
+        assert_eq!(want[0].0[9][0], -9.5, "reduce_min");
         for isa in Isa::available() {
             let got = run(isa, Probe(a, b));
             for (g, w) in got.iter().zip(&want) {

@@ -87,6 +87,22 @@ impl<const N: usize> Vector<N> for P<N> {
         self.bits(self, |x, _| x.is_sign_negative())
     }
     #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        let mut m = self.0[0];
+        for &x in &self.0[1..] {
+            m = if x < m { x } else { m };
+        }
+        m
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        let mut m = self.0[0];
+        for &x in &self.0[1..] {
+            m = if x > m { x } else { m };
+        }
+        m
+    }
+    #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
         P(std::array::from_fn(|i| {
             if m & (1 << i) != 0 { a.0[i] } else { b.0[i] }

@@ -3,12 +3,12 @@
 //! to 8 triangles stored as one SoA block, so one 8-lane sequence tests all children of a node
 //! or all triangles of a leaf.
 //!
-//! Collapse: a bottom-up SAH pass decides which subtrees become leaf blocks (a block test costs
-//! about as much as testing all its triangles one by one would cost for one of them, so small
-//! subtrees collapse into one block unless their halves are much smaller than the whole); then
-//! each wide node starts from a binary node's two children and repeatedly opens the child of
-//! largest surface area until it has 8 (the greedy collapse of Wald et al. 2008 / Embree's
-//! BVH4/8 builders). Child boxes are the binary nodes' boxes, unchanged.
+//! Collapse: the dynamic program of Ylitie, Karras and Laine (HPG 2017, §4.1) over the binary
+//! tree, minimising the surface-area cost of the wide tree: each wide node costs its area times
+//! the cost of one 8-child test, each leaf its area times the cost of one block test (8
+//! triangles at once), and a binary subtree may become one leaf (≤ 8 triangles), one wide node,
+//! or be spread over several of its parent's 8 child slots. Child boxes are the binary nodes'
+//! boxes, unchanged.
 
 use crate::error::{Error, Result};
 use crate::simd::NARROW;
@@ -149,26 +149,32 @@ pub struct Wide {
     pub build_time: Duration,
 }
 
-/// Per binary node: triangles below (saturating past a block), spheres below, and whether the
-/// subtree becomes one leaf.
+/// Slots of a wide node.
+const SLOTS: usize = BRANCH;
+
+/// The dynamic program's choice for one binary node.
 #[derive(Clone, Copy, Default)]
-struct Info {
+struct Choice {
+    /// Triangles below (saturating past a block), spheres below.
     tris: u32,
     spheres: u32,
+    /// As one child of its parent: a leaf (else a wide node).
     leaf: bool,
-    cost: f32,
+    /// `cost[j-1]`: least cost of the subtree spread over at most j child slots.
+    cost: [f32; SLOTS],
+    /// `split[j-1]`: 0 = one child (leaf or node), else slots given to the left subtree.
+    split: [u8; SLOTS],
 }
 
 struct Collapser<'a> {
     bvh: &'a Bvh2,
     geometry: &'a Geometry,
-    info: Vec<Info>,
+    dp: Vec<Choice>,
     out: Wide,
 }
 
 fn half_area(b: &Aabb) -> f32 {
     let d = b.max - b.min;
-    // Flat boxes (an axis-aligned quad) still cost their traversal.
     (d.x * d.y + d.y * d.z + d.z * d.x).max(0.0)
 }
 
@@ -179,11 +185,23 @@ impl Collapser<'_> {
             .is_some()
     }
 
-    /// Bottom-up: counts, and the SAH choice between one leaf block and splitting.
-    fn annotate(&mut self, p: &BuildParams) {
+    /// Best split of at most `j` slots between the children of binary node `n`.
+    fn spread(&self, n: usize, j: usize) -> (f32, u8) {
+        let first = self.bvh.nodes[n].first_index as usize;
+        let (l, r) = (&self.dp[first], &self.dp[first + 1]);
+        let mut best = (f32::INFINITY, 0);
+        for k in 1..j {
+            let c = l.cost[k - 1] + r.cost[j - k - 1];
+            if c < best.0 {
+                best = (c, k as u8);
+            }
+        }
+        best
+    }
+
+    /// Bottom-up: the costs and choices of every binary node.
+    fn solve(&mut self, p: &BuildParams) {
         let nodes = &self.bvh.nodes;
-        // The binary cost of one level: an 8-wide node test stands for three binary levels.
-        let bin_cost = p.node_cost / 3.0;
         let mut order = Vec::with_capacity(nodes.len());
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {
@@ -197,32 +215,52 @@ impl Collapser<'_> {
         for &i in order.iter().rev() {
             let n = &nodes[i];
             let area = half_area(&n.aabb);
-            let mut inf = Info::default();
+            let mut c = Choice::default();
             if n.prim_count > 0 {
                 for slot in n.first_index..n.first_index + n.prim_count {
                     if self.is_sphere(slot) {
-                        inf.spheres += 1;
+                        c.spheres += 1;
                     } else {
-                        inf.tris += 1;
+                        c.tris += 1;
                     }
                 }
-                inf.leaf = true;
-                inf.cost =
-                    area * p.block_cost * (inf.tris.div_ceil(BRANCH as u32) + inf.spheres) as f32;
+                c.leaf = true;
+                let blocks = c.tris.div_ceil(BRANCH as u32) + c.spheres;
+                c.cost = [area * p.block_cost * blocks as f32; SLOTS];
             } else {
-                let (l, r) = (
-                    self.info[n.first_index as usize],
-                    self.info[n.first_index as usize + 1],
-                );
-                inf.tris = (l.tris + r.tris).min(BRANCH as u32 + 1);
-                inf.spheres = (l.spheres + r.spheres).min(2);
-                let split = area * bin_cost + l.cost + r.cost;
-                let fits = inf.spheres == 0 && inf.tris as usize <= BRANCH;
-                let as_leaf = area * p.block_cost;
-                inf.leaf = fits && as_leaf <= split;
-                inf.cost = if inf.leaf { as_leaf } else { split };
+                let first = n.first_index as usize;
+                let (l, r) = (&self.dp[first], &self.dp[first + 1]);
+                c.tris = (l.tris + r.tris).min(BRANCH as u32 + 1);
+                c.spheres = (l.spheres + r.spheres).min(2);
+                let fits = c.spheres == 0 && c.tris as usize <= BRANCH;
+                let as_leaf = if fits {
+                    area * p.block_cost
+                } else {
+                    f32::INFINITY
+                };
+                let as_node = area * p.node_cost + self.spread(i, SLOTS).0;
+                c.leaf = as_leaf <= as_node;
+                let one = as_leaf.min(as_node);
+                c.cost[0] = one;
+                for j in 2..=SLOTS {
+                    let (spread, k) = self.spread(i, j);
+                    (c.cost[j - 1], c.split[j - 1]) =
+                        if one <= spread { (one, 0) } else { (spread, k) };
+                }
             }
-            self.info[i] = inf;
+            self.dp[i] = c;
+        }
+    }
+
+    /// The binary subtrees that take the (at most `j`) slots `n` is given.
+    fn subtrees(&self, n: usize, j: usize, out: &mut Vec<usize>) {
+        match self.dp[n].split[j - 1] {
+            0 => out.push(n),
+            k => {
+                let first = self.bvh.nodes[n].first_index as usize;
+                self.subtrees(first, k as usize, out);
+                self.subtrees(first + 1, j - k as usize, out);
+            }
         }
     }
 
@@ -237,7 +275,7 @@ impl Collapser<'_> {
         }
     }
 
-    /// A leaf child for binary node `i` (its `Info` says it is one).
+    /// A leaf child for binary node `i` (the program made it one).
     fn leaf(&mut self, i: usize) -> Result<Child> {
         let mut slots = vec![];
         self.slots(i, &mut slots);
@@ -276,30 +314,17 @@ impl Collapser<'_> {
         Child::block(self.out.blocks.len() - 1, prims.len())
     }
 
-    /// The child for binary node `i`: a leaf, or a new wide node.
+    /// The child for binary node `i`: a leaf, or a new wide node over the subtrees the program
+    /// spread its 8 slots over.
     fn child(&mut self, i: usize, depth: usize) -> Result<Child> {
-        if self.info[i].leaf {
+        if self.dp[i].leaf {
             return self.leaf(i);
         }
-        let nodes = &self.bvh.nodes;
-        let mut kids = vec![
-            nodes[i].first_index as usize,
-            nodes[i].first_index as usize + 1,
-        ];
-        while kids.len() < BRANCH {
-            let open = kids
-                .iter()
-                .enumerate()
-                .filter(|&(_, &k)| !self.info[k].leaf)
-                .max_by(|a, b| {
-                    half_area(&nodes[*a.1].aabb).total_cmp(&half_area(&nodes[*b.1].aabb))
-                })
-                .map(|(j, _)| j);
-            let Some(j) = open else { break };
-            let k = kids.swap_remove(j);
-            kids.push(nodes[k].first_index as usize);
-            kids.push(nodes[k].first_index as usize + 1);
-        }
+        let first = self.bvh.nodes[i].first_index as usize;
+        let k = self.spread(i, SLOTS).1 as usize;
+        let mut kids = vec![];
+        self.subtrees(first, k, &mut kids);
+        self.subtrees(first + 1, SLOTS - k, &mut kids);
         let index = self.out.nodes.len();
         self.out.nodes.push(Node {
             b: [
@@ -316,7 +341,7 @@ impl Collapser<'_> {
         self.out.depth = self.out.depth.max(depth + 1);
         for (slot, &k) in kids.iter().enumerate() {
             let c = self.child(k, depth + 1)?;
-            let (lo, hi) = (nodes[k].aabb.min, nodes[k].aabb.max);
+            let (lo, hi) = (self.bvh.nodes[k].aabb.min, self.bvh.nodes[k].aabb.max);
             let n = &mut self.out.nodes[index];
             for a in 0..3 {
                 n.b[a][slot] = lo[a];
@@ -346,10 +371,10 @@ impl Wide {
         let mut c = Collapser {
             bvh: &bvh,
             geometry,
-            info: vec![Info::default(); bvh.nodes.len()],
+            dp: vec![Choice::default(); bvh.nodes.len()],
             out,
         };
-        c.annotate(p);
+        c.solve(p);
         c.out.root = c.child(0, 0)?;
         out = c.out;
         out.build_time = start.elapsed();

@@ -1,8 +1,9 @@
 //! The 16-ray packet kernels over the wide BVH, generic over [`Lanes`]: per visited node one
 //! 16-lane slab test per child for the active lanes, a (child, lane-mask) stack, children
 //! pushed far to near by the entry distance of their first active lane, and the watertight
-//! triangle test across lanes. A node (or leaf) reached by fewer than [`HYBRID_LANES`] lanes
-//! is finished one ray at a time (Benthin et al. 2012).
+//! triangle test across lanes. A node reached by fewer than [`super::HYBRID_LANES`] lanes (a
+//! leaf by fewer than [`super::LEAF_LANES`]) is finished one ray at a time (Benthin et al.
+//! 2012).
 //!
 //! Packet set-up is vectorised, and what the lanes share is used: a shared origin (camera
 //! rays) turns `box − origin` into scalar work, shared direction signs pick near/far planes
@@ -11,11 +12,9 @@
 
 use super::build::{Block, Child, Kind, MAX_ROW, Node};
 use super::leaf::{self, Out, Sheared};
-use super::{
-    Best, FAR_SCALE, FAULT_FAR_FIRST, HYBRID_LANES, PacketTracer, Ray1, STACK, TraceStats, single,
-};
+use super::{Best, FAR_SCALE, FAULT_FAR_FIRST, PacketTracer, Ray1, STACK, TraceStats, single};
 use crate::geometry::Ray;
-use crate::simd::{Kernel, Lanes, Mask, Vector, WIDTH};
+use crate::simd::{Kernel, Lanes, Mask, NARROW, Vector, WIDTH};
 use crate::tracer::{CULL_SCALE, HitPacket, LaneMask, NO_HIT, RayPacket};
 use std::mem::MaybeUninit;
 
@@ -34,6 +33,12 @@ struct Prep<V> {
     origin: [f32; 3],
     /// Near-plane row per axis when every active lane's direction has the same sign there.
     near_row: [usize; 3],
+    /// Per axis, the smallest and largest origin and reciprocal direction over the active
+    /// lanes: the interval test of all children at once (only with shared signs).
+    o_lo: [f32; 3],
+    o_hi: [f32; 3],
+    i_lo: [f32; 3],
+    i_hi: [f32; 3],
     lanes: Lanes16,
 }
 
@@ -109,18 +114,21 @@ impl<V: Vector<WIDTH>> Prep<V> {
         });
         let first = active.trailing_zeros() as usize;
         let origin = [p.ox[first], p.oy[first], p.oz[first]];
+        let o = [V::load(&p.ox), V::load(&p.oy), V::load(&p.oz)];
+        let (inf, ninf) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
+        let (mut o_lo, mut o_hi, mut i_lo, mut i_hi) = ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
         let mut shared = true;
-        let mut rest = active;
-        while rest != 0 {
-            let l = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            shared &= p.ox[l].to_bits() == origin[0].to_bits()
-                && p.oy[l].to_bits() == origin[1].to_bits()
-                && p.oz[l].to_bits() == origin[2].to_bits();
-        }
         let mut near_row = [0; 3];
         let mut signs = true;
         for a in 0..3 {
+            // Bit-for-bit equal: equal as floats with equal sign bits.
+            let o0 = V::splat(origin[a]);
+            let same = o[a].eq(o0) & !(o[a].sign() ^ o0.sign());
+            shared &= same & active == active;
+            o_lo[a] = V::select(active, o[a], inf).reduce_min();
+            o_hi[a] = V::select(active, o[a], ninf).reduce_max();
+            i_lo[a] = V::select(active, inv[a], inf).reduce_min();
+            i_hi[a] = V::select(active, inv[a], ninf).reduce_max();
             let s = inv[a].sign() & active;
             signs &= s == 0 || s == active;
             near_row[a] = if s != 0 { a + MAX_ROW } else { a };
@@ -132,13 +140,17 @@ impl<V: Vector<WIDTH>> Prep<V> {
         };
         (
             Prep {
-                o: [V::load(&p.ox), V::load(&p.oy), V::load(&p.oz)],
+                o,
                 inv,
                 shear,
                 kmask,
                 uniform,
                 origin,
                 near_row,
+                o_lo,
+                o_hi,
+                i_lo,
+                i_hi,
                 lanes: Lanes16 {
                     inv: inv_a,
                     shear: shear_a,
@@ -172,13 +184,8 @@ impl<V: Vector<WIDTH>> Prep<V> {
     /// Per lane, component `k[j]` of (x, y, z).
     #[inline(always)]
     fn pick(&self, j: usize, v: &[V; 3]) -> V {
-        match self.uniform {
-            Some(k) => v[k[j]],
-            None => {
-                let m = &self.kmask[j];
-                V::select(m[0], v[0], V::select(m[1], v[1], v[2]))
-            }
-        }
+        let m = &self.kmask[j];
+        V::select(m[0], v[0], V::select(m[1], v[1], v[2]))
     }
 
     /// Triangle `slot` of a block in every lane's sheared space.
@@ -192,25 +199,48 @@ impl<V: Vector<WIDTH>> Prep<V> {
         };
         for vtx in 0..3 {
             let v = &blk.v[vtx];
-            let p = if ORIGIN {
-                [
-                    V::splat(v[0][slot] - self.origin[0]),
-                    V::splat(v[1][slot] - self.origin[1]),
-                    V::splat(v[2][slot] - self.origin[2]),
-                ]
-            } else {
-                [
-                    V::splat(v[0][slot]).sub(self.o[0]),
-                    V::splat(v[1][slot]).sub(self.o[1]),
-                    V::splat(v[2][slot]).sub(self.o[2]),
-                ]
+            let (px, py, pz) = match self.uniform {
+                // The permutation picks rows of the block: no per-lane shuffles.
+                Some(k) => (
+                    self.rel::<ORIGIN>(v, k[0], slot),
+                    self.rel::<ORIGIN>(v, k[1], slot),
+                    self.rel::<ORIGIN>(v, k[2], slot),
+                ),
+                None => {
+                    let p = [
+                        self.rel::<ORIGIN>(v, 0, slot),
+                        self.rel::<ORIGIN>(v, 1, slot),
+                        self.rel::<ORIGIN>(v, 2, slot),
+                    ];
+                    (self.pick(0, &p), self.pick(1, &p), self.pick(2, &p))
+                }
             };
-            let (px, py, pz) = (self.pick(0, &p), self.pick(1, &p), self.pick(2, &p));
             s.x[vtx] = px.sub(self.shear[0].mul(pz));
             s.y[vtx] = py.sub(self.shear[1].mul(pz));
             s.z[vtx] = self.shear[2].mul(pz);
         }
         s
+    }
+
+    /// Coordinate `a` of a block vertex relative to every lane's origin.
+    #[inline(always)]
+    fn rel<const ORIGIN: bool>(&self, v: &[[f32; NARROW]; 3], a: usize, slot: usize) -> V {
+        if ORIGIN {
+            V::splat(v[a][slot] - self.origin[a])
+        } else {
+            V::splat(v[a][slot]).sub(self.o_axis(a))
+        }
+    }
+
+    /// The origin vector of axis `a` (a runtime index: selected, not indexed, so the vectors
+    /// stay in registers).
+    #[inline(always)]
+    fn o_axis(&self, a: usize) -> V {
+        match a {
+            0 => self.o[0],
+            1 => self.o[1],
+            _ => self.o[2],
+        }
     }
 
     /// Lanes whose ray meets child `i`'s box within (0, cull); entry distances in `near_out`.
@@ -263,22 +293,114 @@ impl<V: Vector<WIDTH>> Prep<V> {
         near.le(far)
     }
 
+    /// Children that some lane may hit: the slab test of all 8 children at once (one 8-lane
+    /// sequence) on the interval hull of the lanes' origins and reciprocal directions, with
+    /// the largest cull distance of the lanes. Rounding is monotone, so the hull's extreme
+    /// products bound every lane's computed distances: a child rejected here is rejected by
+    /// each lane's own test (Wald et al. 2007's interval culling, exact in floating point).
+    #[inline(always)]
+    fn interval<W: Vector<NARROW>, const ORIGIN: bool>(&self, n: &Node, cull_max: f32) -> u32 {
+        let lo = [W::load(&n.b[0]), W::load(&n.b[1]), W::load(&n.b[2])];
+        let hi = [W::load(&n.b[3]), W::load(&n.b[4]), W::load(&n.b[5])];
+        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0, cull_max)
+    }
+
+    /// Triangles of a block that some lane may hit: [`Self::interval`] on the triangles'
+    /// boxes, widened by 2⁻¹⁶ of the distances, far beyond the rounding by which the
+    /// watertight test can accept a ray passing just outside a triangle's box.
+    #[inline(always)]
+    fn interval_tris<W: Vector<NARROW>, const ORIGIN: bool>(
+        &self,
+        blk: &Block,
+        cull_max: f32,
+    ) -> u32 {
+        let z = W::splat(0.0);
+        let (mut lo, mut hi) = ([z; 3], [z; 3]);
+        for a in 0..3 {
+            let (p, q, r) = (
+                W::load(&blk.v[0][a]),
+                W::load(&blk.v[1][a]),
+                W::load(&blk.v[2][a]),
+            );
+            lo[a] = p.min(q).min(r);
+            hi[a] = p.max(q).max(r);
+        }
+        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0 + 1.0 / 65536.0, cull_max)
+    }
+
+    /// The interval slab test of 8 boxes; `widen` ≥ 1 scales the far distances up and the
+    /// near ones down.
+    #[inline(always)]
+    fn interval_boxes<W: Vector<NARROW>, const ORIGIN: bool>(
+        &self,
+        lo: &[W; 3],
+        hi: &[W; 3],
+        widen: f32,
+        cull_max: f32,
+    ) -> u32 {
+        let mut near = W::splat(0.0);
+        let mut far = W::splat(f32::INFINITY);
+        for a in 0..3 {
+            let (bn, bf) = if self.near_row[a] < MAX_ROW {
+                (lo[a], hi[a])
+            } else {
+                (hi[a], lo[a])
+            };
+            let (il, ih) = (W::splat(self.i_lo[a]), W::splat(self.i_hi[a]));
+            if ORIGIN {
+                let o = W::splat(self.origin[a]);
+                let (dn, df) = (bn.sub(o), bf.sub(o));
+                near = dn.mul(il).min(dn.mul(ih)).max(near);
+                far = df.mul(il).max(df.mul(ih)).min(far);
+            } else {
+                let (ol, oh) = (W::splat(self.o_lo[a]), W::splat(self.o_hi[a]));
+                let (n0, n1) = (bn.sub(oh), bn.sub(ol));
+                let (f0, f1) = (bf.sub(oh), bf.sub(ol));
+                let nmin = n0.mul(il).min(n0.mul(ih)).min(n1.mul(il).min(n1.mul(ih)));
+                let fmax = f0.mul(il).max(f0.mul(ih)).max(f1.mul(il).max(f1.mul(ih)));
+                near = nmin.max(near);
+                far = fmax.min(far);
+            }
+        }
+        let (near, far) = if widen > 1.0 {
+            (
+                near.div(W::splat(widen)),
+                far.mul(W::splat(FAR_SCALE * widen)),
+            )
+        } else {
+            (near, far.mul(W::splat(FAR_SCALE)))
+        };
+        near.le(far.min(W::splat(cull_max)))
+    }
+
     /// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
     /// entry distance of each child's first lane.
     #[inline(always)]
-    fn push_children<const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    fn push_children<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         &self,
         n: &Node,
         m: u32,
         cull: V,
         stack: &mut Stack,
     ) {
-        let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask); 8];
+        let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask, 0.0f32); 8];
         let mut k = 0;
         let mut near = [0.0; WIDTH];
-        for i in 0..n.count as usize {
+        let inf = V::splat(f32::INFINITY);
+        let mut cand = if SIGNS {
+            let cull_max = V::select(m, cull, V::splat(f32::NEG_INFINITY)).reduce_max();
+            self.interval::<W, ORIGIN>(n, cull_max)
+        } else {
+            (1 << n.count) - 1
+        };
+        while cand != 0 {
+            let i = cand.trailing_zeros() as usize;
+            cand &= cand - 1;
             let hit = m & self.slab::<ORIGIN, SIGNS>(n, i, cull, &mut near);
             if hit != 0 {
+                // The smallest entry distance of the child's lanes: lanes whose closest hit
+                // is nearer by the time it is popped skip it.
+                let entry = V::select(hit, V::load(&near), inf).reduce_min();
                 let key = near[hit.trailing_zeros() as usize];
                 let key = if FAULT & FAULT_FAR_FIRST != 0 {
                     -key
@@ -291,19 +413,19 @@ impl<V: Vector<WIDTH>> Prep<V> {
                     keys[j] = keys[j - 1];
                     j -= 1;
                 }
-                keys[j] = (key, n.child[i], hit as Mask);
+                keys[j] = (key, n.child[i], hit as Mask, entry);
                 k += 1;
             }
         }
-        for &(_, c, hm) in &keys[..k] {
-            stack.push(c, hm);
+        for &(_, c, hm, entry) in &keys[..k] {
+            stack.push(c, hm, entry);
         }
     }
 }
 
-/// A (child, lane-mask) stack without initialising its storage.
+/// A (child, lane mask, smallest entry distance) stack without initialising its storage.
 struct Stack {
-    e: [MaybeUninit<(Child, Mask)>; STACK],
+    e: [MaybeUninit<(Child, Mask, f32)>; STACK],
     sp: usize,
 }
 
@@ -314,24 +436,24 @@ impl Stack {
             e: [const { MaybeUninit::uninit() }; STACK],
             sp: 0,
         };
-        s.push(root, active);
+        s.push(root, active, 0.0);
         s
     }
     #[inline(always)]
-    fn push(&mut self, c: Child, m: Mask) {
+    fn push(&mut self, c: Child, m: Mask, entry: f32) {
         // The build bounds depth · BRANCH by STACK; indexing checks anyway.
-        self.e[self.sp] = MaybeUninit::new((c, m));
+        self.e[self.sp] = MaybeUninit::new((c, m, entry));
         self.sp += 1;
     }
     #[inline(always)]
-    fn pop(&mut self) -> Option<(Child, u32)> {
+    fn pop(&mut self) -> Option<(Child, u32, f32)> {
         if self.sp == 0 {
             return None;
         }
         self.sp -= 1;
         // SAFETY: entries below sp were written by push.
-        let (c, m) = unsafe { self.e[self.sp].assume_init() };
-        Some((c, m as u32))
+        let (c, m, t) = unsafe { self.e[self.sp].assume_init() };
+        Some((c, m as u32, t))
     }
 }
 
@@ -454,8 +576,23 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
     let g = &*tr.geometry;
     let mut stack = Stack::new(tr.wide.root, active);
     let mut out = [[0.0f32; WIDTH]; 3];
-    while let Some((c, m)) = stack.pop() {
-        if m.count_ones() < HYBRID_LANES {
+    while let Some((c, m, entry)) = stack.pop() {
+        // Drop the lanes whose closest hit now lies before the child (as their slab test
+        // would: conservative, since entry is the smallest of the lanes' entry distances).
+        let passed = L::V::load(&best.t)
+            .mul(L::V::splat(CULL_SCALE))
+            .lt(L::V::splat(entry));
+        let m = m & !passed;
+        if m == 0 {
+            continue;
+        }
+        if m.count_ones()
+            < if c.is_inner() {
+                tr.hybrid.0
+            } else {
+                tr.hybrid.1
+            }
+        {
             let mut rest = m;
             while rest != 0 {
                 let l = rest.trailing_zeros() as usize;
@@ -473,13 +610,20 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                 stats.packet_nodes += 1;
                 stats.packet_lanes += m.count_ones() as u64;
                 let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                p.push_children::<FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+                p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
             }
             Kind::Block(b, count) => {
                 stats.leaves += 1;
                 let blk = &tr.wide.blocks[b as usize];
                 let tm = best.test_tmax::<L::V>();
-                for slot in 0..count as usize {
+                let mut cand = (1u32 << count) - 1;
+                if SIGNS {
+                    let cull_max = L::V::select(m, tm, L::V::splat(f32::NEG_INFINITY)).reduce_max();
+                    cand &= p.interval_tris::<L::W, ORIGIN>(blk, cull_max);
+                }
+                while cand != 0 {
+                    let slot = cand.trailing_zeros() as usize;
+                    cand &= cand - 1;
                     let s = p.sheared::<ORIGIN>(blk, slot);
                     let prim = blk.prim[slot];
                     let (hit, mut rest) =
@@ -560,12 +704,18 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
     // Lanes still looking for an occluder; a lane retires at its first hit.
     let mut alive = active as u32;
     let mut stack = Stack::new(tr.wide.root, active);
-    while let Some((c, m)) = stack.pop() {
+    while let Some((c, m, _)) = stack.pop() {
         let mut m = m & alive;
         if m == 0 {
             continue;
         }
-        if m.count_ones() < HYBRID_LANES {
+        if m.count_ones()
+            < if c.is_inner() {
+                tr.hybrid.0
+            } else {
+                tr.hybrid.1
+            }
+        {
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
@@ -579,12 +729,20 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                     let n = &tr.wide.nodes[i as usize];
                     stats.packet_nodes += 1;
                     stats.packet_lanes += m.count_ones() as u64;
-                    p.push_children::<FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+                    p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
                 }
                 Kind::Block(b, count) => {
                     stats.leaves += 1;
                     let blk = &tr.wide.blocks[b as usize];
-                    for slot in 0..count as usize {
+                    let mut cand = (1u32 << count) - 1;
+                    if SIGNS {
+                        let cull_max =
+                            L::V::select(m, tm, L::V::splat(f32::NEG_INFINITY)).reduce_max();
+                        cand &= p.interval_tris::<L::W, ORIGIN>(blk, cull_max);
+                    }
+                    while cand != 0 {
+                        let slot = cand.trailing_zeros() as usize;
+                        cand &= cand - 1;
                         let s = p.sheared::<ORIGIN>(blk, slot);
                         let prim = blk.prim[slot];
                         let (mut occ, mut rest) =

@@ -45,6 +45,10 @@ pub const FAULT_FAR_FIRST: u32 = 2;
 /// throughput on bunny and the dragon (docs/tracer.md).
 pub const HYBRID_LANES: u32 = 6;
 
+/// The same switch at a leaf: a 16-lane triangle test costs about as much as one ray's test of
+/// a whole 8-triangle block, so a packet keeps testing leaves with fewer lanes.
+pub const LEAF_LANES: u32 = 3;
+
 /// Work counters, for the `rays` harness.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TraceStats {
@@ -174,6 +178,8 @@ pub struct PacketTracer {
     geometry: Arc<Geometry>,
     wide: Wide,
     isa: Isa,
+    /// The hybrid switch: (node, leaf) lane counts below which lanes go on alone.
+    hybrid: (u32, u32),
 }
 
 impl PacketTracer {
@@ -195,7 +201,15 @@ impl PacketTracer {
             geometry,
             wide,
             isa,
+            hybrid: (HYBRID_LANES, LEAF_LANES),
         })
+    }
+
+    /// Another hybrid switch (benches that tune it): lanes at a node (a leaf) go on alone
+    /// below `node` (`leaf`) active lanes; 0 keeps packets whole, 17 traces every ray alone.
+    pub fn with_hybrid(mut self, node: u32, leaf: u32) -> Self {
+        self.hybrid = (node, leaf);
+        self
     }
 
     pub fn isa(&self) -> Isa {
