@@ -11,7 +11,8 @@
 //! `DIBENCH_HYBRID_SWEEP=1 cargo bench --bench rays` first times the packet backend at the best
 //! ISA with several hybrid switches (node lanes, leaf lanes), interleaved round by round (the
 //! `dibench rays` protocol), and prints Mrays/s per class with the measured lane occupancy:
-//! how `HYBRID_LANES`/`LEAF_LANES` were chosen.
+//! how `HYBRID_LANES`/`LEAF_LANES` were chosen. `DIBENCH_BUILD_SWEEP=1` does the same for
+//! build parameters (obvhs preset × SAH block cost), with build times and tree shapes.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use dibench::harness::rays::{Subject, generate, measure, subjects};
@@ -71,9 +72,57 @@ fn hybrid_sweep() {
     }
 }
 
+/// The build-parameter sweep (see the module docs).
+fn build_sweep() {
+    use dibench::tracer::packet::BuildParams;
+    use obvhs::BvhBuildParams as P;
+    let presets = [
+        ("fast", P::fast_build()),
+        ("medium", P::medium_build()),
+        ("very_slow", P::very_slow_build()),
+    ];
+    let isa = Isa::available()[0];
+    for name in ["bunny", "dragon"] {
+        let Some(scene) = scene(name) else { continue };
+        let sets = generate(&scene, 256, 1);
+        let mut labels = vec![];
+        let mut subjects = vec![];
+        for (pname, preset) in presets {
+            for block_cost in [1.0, 1.5, 2.5] {
+                let p = BuildParams {
+                    preset: P {
+                        max_prims_per_leaf: 1,
+                        ..preset
+                    },
+                    block_cost,
+                    ..BuildParams::default()
+                };
+                let tr = PacketTracer::build_with(scene.geometry.clone(), isa, &p).unwrap();
+                println!("{name} {pname} block_cost {block_cost}: {}", tr.wide().describe());
+                labels.push(format!("{pname}/{block_cost}"));
+                subjects.push(Subject::Packet(tr));
+            }
+        }
+        let rows = measure(name, &sets, &subjects, 7, 1);
+        println!("build sweep, {name}, {}: Mrays/s per (preset/block cost)", isa.name());
+        for set in &sets {
+            let line: Vec<String> = rows
+                .iter()
+                .filter(|r| r.ray_class == set.class)
+                .zip(&labels)
+                .map(|(r, l)| format!("{l}: {:.2}", r.mrays_per_s))
+                .collect();
+            println!("  {:<15} {}", set.class, line.join("  "));
+        }
+    }
+}
+
 fn rays(c: &mut Criterion) {
     if std::env::var_os("DIBENCH_HYBRID_SWEEP").is_some() {
         hybrid_sweep();
+    }
+    if std::env::var_os("DIBENCH_BUILD_SWEEP").is_some() {
+        build_sweep();
     }
     for name in ["bunny", "dragon"] {
         let Some(scene) = scene(name) else { continue };

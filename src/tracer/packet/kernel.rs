@@ -31,6 +31,8 @@ struct Prep<V> {
     uniform: Option<[usize; 3]>,
     /// The origin when every active lane shares it (bit for bit).
     origin: [f32; 3],
+    /// Lanes whose direction is negative along their dominant axis.
+    neg: u32,
     /// Near-plane row per axis when every active lane's direction has the same sign there.
     near_row: [usize; 3],
     /// Per axis, the smallest and largest origin and reciprocal direction over the active
@@ -146,6 +148,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
                 kmask,
                 uniform,
                 origin,
+                neg,
                 near_row,
                 o_lo,
                 o_hi,
@@ -163,11 +166,12 @@ impl<V: Vector<WIDTH>> Prep<V> {
     /// Lane `l` as a single ray, from the packet's set-up (no recomputation).
     #[inline(always)]
     fn ray1(&self, p: &RayPacket, l: usize) -> Ray1 {
-        let k = [
-            axis(&self.kmask, 0, l),
-            axis(&self.kmask, 1, l),
-            axis(&self.kmask, 2, l),
-        ];
+        // kz from the dominant-axis masks, (kx, ky) from kz and the sign (as WatertightRay).
+        const XY: [[[usize; 2]; 2]; 3] = [[[1, 2], [2, 1]], [[2, 0], [0, 2]], [[0, 1], [1, 0]]];
+        let (b0, b1) = ((self.kmask[2][0] >> l) & 1, (self.kmask[2][1] >> l) & 1);
+        let kz = (2 - 2 * b0 - b1) as usize;
+        let [kx, ky] = XY[kz][((self.neg >> l) & 1) as usize];
+        let k = [kx, ky, kz];
         let s = [
             self.lanes.shear[0][l],
             self.lanes.shear[1][l],

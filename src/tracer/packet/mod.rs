@@ -155,13 +155,7 @@ impl Ray1 {
     /// From constants a packet set-up computed (the same values as [`Self::new`]).
     #[inline(always)]
     pub fn from_parts(ray: Ray, inv: [f32; 3], k: [usize; 3], s: [f32; 3]) -> Self {
-        let row = |a: usize| {
-            if inv[a].is_sign_negative() {
-                a + build::MAX_ROW
-            } else {
-                a
-            }
-        };
+        let row = |a: usize| a + build::MAX_ROW * (inv[a].to_bits() >> 31) as usize;
         Ray1 {
             ray,
             o: ray.origin.to_array(),
