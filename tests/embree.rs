@@ -5,7 +5,7 @@
 
 use dibench::geometry::{Hit, Ray};
 use dibench::harness::crosscheck::{self, Mode, Traced, exact_t};
-use dibench::harness::raysets::RaySet;
+use dibench::harness::raysets::{Query, RaySet};
 use dibench::prepare::PreparedScene;
 use dibench::sampling::stream::SampleStream;
 use dibench::sampling::warp::sample_uniform_sphere;
@@ -193,11 +193,8 @@ fn crosscheck_passes_on_every_scene() {
 fn crosscheck_detects_a_wrong_backend() {
     // The comparison must be able to fail: shifting every t by 1 % is caught.
     let scene = load("cornell");
-    let set = RaySet {
-        name: "primary",
-        rays: random_rays(&scene, 512, 2),
-        coherent: false,
-    };
+    let rays = random_rays(&scene, 512, 2);
+    let set = RaySet::from_rays("primary", Query::Closest, false, &rays);
     let reference = Traced {
         hits: crosscheck::trace_closest(scene.tracer.as_ref(), &set, Mode::Single),
         occluded: crosscheck::trace_occluded(scene.tracer.as_ref(), &set, Mode::Single),
@@ -210,8 +207,8 @@ fn crosscheck_detects_a_wrong_backend() {
         h.t *= 1.01;
     }
     shifted.occluded[0] = !shifted.occluded[0];
-    let a = crosscheck::agreement(&scene, &set.rays, &reference, &shifted);
-    assert!(!a.failures(set.rays.len()).is_empty());
+    let a = crosscheck::agreement(&scene, &rays, &reference, &shifted);
+    assert!(!a.failures(rays.len()).is_empty());
     assert_eq!(a.occlusion_mismatch, 1);
 }
 

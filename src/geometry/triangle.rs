@@ -60,6 +60,19 @@ impl WatertightRay {
     pub fn shear(&self) -> [f32; 3] {
         [self.sx, self.sy, self.sz]
     }
+
+    /// Reassembles the constants a SIMD kernel computed lane by lane with the operations of
+    /// [`Self::new`] (the same values, bit for bit).
+    pub fn from_parts(axes: [usize; 3], shear: [f32; 3]) -> Self {
+        WatertightRay {
+            kx: axes[0],
+            ky: axes[1],
+            kz: axes[2],
+            sx: shear[0],
+            sy: shear[1],
+            sz: shear[2],
+        }
+    }
 }
 
 /// |det| times the error bound of the watertight test's t (pbrt-v4 §6.8.7, `deltaT`), from

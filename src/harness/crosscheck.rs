@@ -2,7 +2,7 @@
 //! each with `obvhs` (the reference), times them single-threaded, and renders a few passes on
 //! each backend to compare the images.
 
-use super::raysets::{self, RaySet};
+use super::raysets::{self, Query, RaySet};
 use crate::error::{Error, Result};
 use crate::film::{Film, Image};
 use crate::geometry::triangle::WatertightRay;
@@ -10,7 +10,7 @@ use crate::geometry::{Hit, Ray};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy;
-use crate::tracer::{HitPacket, LANES, RayPacket, Tracer, backends};
+use crate::tracer::{HitPacket, LANES, Tracer, backends};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -76,51 +76,38 @@ pub struct Traced {
 }
 
 pub fn trace_closest(tracer: &dyn Tracer, set: &RaySet, mode: Mode) -> Vec<Option<Hit>> {
-    match mode {
-        Mode::Single => set.rays.iter().map(|r| tracer.intersect(r)).collect(),
-        Mode::Packet16 => {
-            let mut out = Vec::with_capacity(set.rays.len());
-            let mut hits = HitPacket::default();
-            for chunk in set.packets() {
-                let (packet, active) = pack(chunk);
+    let mut out = Vec::with_capacity(set.rays() as usize);
+    let mut hits = HitPacket::default();
+    for (p, &m) in set.packets.iter().zip(&set.masks) {
+        let lanes = (0..LANES).filter(|l| m & (1 << l) != 0);
+        match mode {
+            Mode::Single => out.extend(lanes.map(|l| tracer.intersect(&p.get(l)))),
+            Mode::Packet16 => {
                 if set.coherent {
-                    tracer.intersect_packet_coherent(&packet, active, &mut hits);
+                    tracer.intersect_packet_coherent(p, m, &mut hits);
                 } else {
-                    tracer.intersect_packet(&packet, active, &mut hits);
+                    tracer.intersect_packet(p, m, &mut hits);
                 }
-                out.extend((0..chunk.len()).map(|l| hits.get(l)));
+                out.extend(lanes.map(|l| hits.get(l)));
             }
-            out
         }
     }
+    out
 }
 
 pub fn trace_occluded(tracer: &dyn Tracer, set: &RaySet, mode: Mode) -> Vec<bool> {
-    match mode {
-        Mode::Single => set.rays.iter().map(|r| tracer.occluded(r)).collect(),
-        Mode::Packet16 => {
-            let mut out = Vec::with_capacity(set.rays.len());
-            for chunk in set.packets() {
-                let (packet, active) = pack(chunk);
-                let m = tracer.occluded_packet(&packet, active);
-                out.extend((0..chunk.len()).map(|l| m & (1 << l) != 0));
+    let mut out = Vec::with_capacity(set.rays() as usize);
+    for (p, &m) in set.packets.iter().zip(&set.masks) {
+        let lanes = (0..LANES).filter(|l| m & (1 << l) != 0);
+        match mode {
+            Mode::Single => out.extend(lanes.map(|l| tracer.occluded(&p.get(l)))),
+            Mode::Packet16 => {
+                let o = tracer.occluded_packet(p, m);
+                out.extend(lanes.map(|l| o & (1 << l) != 0));
             }
-            out
         }
     }
-}
-
-fn pack(rays: &[Ray]) -> (RayPacket, u16) {
-    let mut p = RayPacket::default();
-    for (l, r) in rays.iter().enumerate() {
-        p.set(l, r);
-    }
-    let active = if rays.len() == LANES {
-        u16::MAX
-    } else {
-        (1u16 << rays.len()) - 1
-    };
-    (p, active)
+    out
 }
 
 /// Distance at which our exact test hits primitive `prim`, if it does.
@@ -256,7 +243,7 @@ fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
 /// `<out>/<scene>/crosscheck.csv`. Tracing and timing run on the calling thread; the renders
 /// use the current rayon pool.
 pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
-    let sets = raysets::generate(scene, seed);
+    let sets = raysets::generate(scene, scene.scene.width, scene.scene.height, seed);
     let names = backends::AVAILABLE;
     let tracers: Vec<Box<dyn Tracer>> = names
         .iter()
@@ -267,7 +254,8 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
     let mut rows = Vec::new();
     let mut failures = Vec::new();
     for set in &sets {
-        let shadow = set.name == "shadow_area";
+        let shadow = set.query == Query::Occluded;
+        let rays = set.flat();
         // traced[b][m], best time[b][m]; backends interleaved round by round so load changes
         // on the shared machine hit all of them alike.
         let mut best = vec![[f64::INFINITY; 2]; tracers.len()];
@@ -289,22 +277,22 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
         }
         for (b, name) in names.iter().enumerate() {
             for (m, mode) in modes.iter().enumerate() {
-                let a = agreement(scene, &set.rays, &traced[0][0], &traced[b][m]);
-                let why = a.failures(set.rays.len());
+                let a = agreement(scene, &rays, &traced[0][0], &traced[b][m]);
+                let why = a.failures(rays.len());
                 for w in &why {
                     failures.push(format!(
                         "{scene_name}/{}/{name}/{}: {w}",
-                        set.name,
+                        set.class,
                         mode.name()
                     ));
                 }
                 let secs = best[b][m];
                 rows.push(Row {
                     scene: scene_name.clone(),
-                    set: set.name.into(),
+                    set: set.class.into(),
                     backend: (*name).into(),
                     mode: mode.name().into(),
-                    rays: set.rays.len(),
+                    rays: rays.len(),
                     hit_mismatch: a.hit_mismatch,
                     prim_mismatch: a.prim_mismatch,
                     ties: a.ties,
@@ -313,7 +301,7 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
                     timed_query: if shadow { "occluded" } else { "closest" }.into(),
                     seconds: secs,
                     mrays_per_s: if secs > 0.0 {
-                        set.rays.len() as f64 / secs / 1e6
+                        rays.len() as f64 / secs / 1e6
                     } else {
                         0.0
                     },

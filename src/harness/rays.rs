@@ -1,134 +1,35 @@
-//! Ray-throughput harness: fixed ray sets generated from a scene, traced by each backend
-//! (and each ISA of the packet backend), interleaved round by round so machine noise hits
-//! all alike.
+//! Ray-throughput harness: the fixed ray sets of [`raysets`], traced by each backend (and each
+//! ISA of the packet backend), interleaved round by round so machine noise hits all alike.
 
+use super::raysets;
+pub use super::raysets::{Query, RaySet};
 use crate::error::{Error, Result};
-use crate::geometry::Ray;
-use crate::math::{mix64, offset_ray_origin};
 use crate::prepare::PreparedScene;
-use crate::render::camera_ray;
-use crate::sampling::warp::sample_uniform_sphere;
 use crate::simd::Isa;
+use crate::tracer::backends;
 use crate::tracer::bvh::ObvhsTracer;
 use crate::tracer::packet::{PacketTracer, TraceStats};
-use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket, Tracer};
-use glam::Vec3;
+use crate::tracer::{HitPacket, LaneMask, RayPacket, Tracer};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Backends the `rays`, `compare` and `reference` commands know.
-pub const BACKENDS: &[&str] = &[
-    "obvhs",
-    "packet",
-    #[cfg(feature = "embree")]
-    "embree",
-];
+/// Backends the `rays`, `compare` and `reference` commands know: the one registry,
+/// [`backends::AVAILABLE`].
+pub const BACKENDS: &[&str] = backends::AVAILABLE;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Query {
-    Closest,
-    Occluded,
-}
-
-/// One ray class as 16-ray packets (4×4 pixel tiles) with their active masks.
-pub struct RaySet {
-    pub class: &'static str,
-    pub query: Query,
-    pub packets: Vec<RayPacket>,
-    pub masks: Vec<LaneMask>,
-}
-
-impl RaySet {
-    pub fn rays(&self) -> u64 {
-        self.masks.iter().map(|m| m.count_ones() as u64).sum()
-    }
-}
-
-/// Uniform [0, 1) from a hashed key: fixed ray sets without RNG state.
-fn u01(key: u64) -> f32 {
-    (mix64(key) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-}
-
-/// Generates `primary`, `shadow_area`, `shadow_distant` and `incoherent` rays for a `size`²
-/// image of the scene's camera. Secondary rays start at the primary hits (offset off the
-/// surface) and stay in the primary's packet lane, as the renderer groups them.
+/// The ray sets of `dibench rays`: [`raysets::generate`] for a `size`² image.
 pub fn generate(scene: &PreparedScene, size: u32, seed: u64) -> Vec<RaySet> {
-    let cam = &scene.scene.camera;
-    let tiles = size.div_ceil(4);
-    let distant = Vec3::new(0.35, 1.0, 0.25).normalize();
-    let mut sets: Vec<RaySet> = [
-        ("primary", Query::Closest),
-        ("shadow_area", Query::Occluded),
-        ("shadow_distant", Query::Occluded),
-        ("incoherent", Query::Closest),
-    ]
-    .into_iter()
-    .map(|(class, query)| RaySet {
-        class,
-        query,
-        packets: vec![],
-        masks: vec![],
-    })
-    .collect();
-    let mut hits = HitPacket::default();
-    for ty in 0..tiles {
-        for tx in 0..tiles {
-            let mut p = [RayPacket::default(); 4];
-            let mut m = [0 as LaneMask; 4];
-            for lane in 0..LANES {
-                let (x, y) = (tx * 4 + lane as u32 % 4, ty * 4 + lane as u32 / 4);
-                if x < size && y < size {
-                    p[0].set(lane, &camera_ray(cam, size, size, x, y, [0.5, 0.5]));
-                    m[0] |= 1 << lane;
-                }
-            }
-            scene.tracer.intersect_packet(&p[0], m[0], &mut hits);
-            for lane in 0..LANES {
-                let Some(hit) = hits.get(lane) else { continue };
-                let ray = p[0].get(lane);
-                let surf = scene.surface(&ray, &hit);
-                let n = if surf.ng.dot(ray.dir) < 0.0 {
-                    surf.ng
-                } else {
-                    -surf.ng
-                };
-                let o = offset_ray_origin(surf.p, surf.p_error, n);
-                let key = seed ^ ((ty as u64 * tiles as u64 + tx as u64) << 4 | lane as u64) << 8;
-                let u = |i: u64| u01(key.wrapping_add(i));
-                if let Some((_, ls)) = scene.sample_light(
-                    o,
-                    u(1),
-                    [u(2), u(3), u(4)],
-                    &crate::lights::LightMethods::BASIC,
-                ) && let Some(r) = ls.shadow_ray(o)
-                {
-                    p[1].set(lane, &r);
-                    m[1] |= 1 << lane;
-                }
-                p[2].set(lane, &Ray::new(o, distant, f32::INFINITY));
-                m[2] |= 1 << lane;
-                let d = sample_uniform_sphere([u(5), u(6)]);
-                let d = if d.dot(n) < 0.0 { -d } else { d };
-                p[3].set(lane, &Ray::new(o, d, f32::INFINITY));
-                m[3] |= 1 << lane;
-            }
-            for k in 0..4 {
-                if m[k] != 0 {
-                    sets[k].packets.push(p[k]);
-                    sets[k].masks.push(m[k]);
-                }
-            }
-        }
-    }
-    sets
+    raysets::generate(scene, size, size, seed)
 }
 
 /// A backend under test: the obvhs baseline or the packet tracer at one ISA.
 pub enum Subject {
     Obvhs(ObvhsTracer),
     Packet(PacketTracer),
+    /// The packet backend's single-ray kernel on every ray alone (benches; not a backend).
+    Single(PacketTracer),
     /// Embree with `rtcIntersect1/rtcOccluded1` per ray (`packet: false`) or its 16-wide
     /// kernels (`packet: true`), for the side-by-side with our packet core.
     #[cfg(feature = "embree")]
@@ -143,6 +44,7 @@ impl Subject {
         match self {
             Subject::Obvhs(_) => ("obvhs", "scalar"),
             Subject::Packet(p) => ("packet", p.isa().name()),
+            Subject::Single(p) => ("packet-1ray", p.isa().name()),
             #[cfg(feature = "embree")]
             Subject::Embree { packet, .. } => ("embree", if *packet { "16-wide" } else { "1-ray" }),
         }
@@ -151,7 +53,7 @@ impl Subject {
     fn tracer(&self) -> &dyn Tracer {
         match self {
             Subject::Obvhs(t) => t,
-            Subject::Packet(t) => t,
+            Subject::Packet(t) | Subject::Single(t) => t,
             #[cfg(feature = "embree")]
             Subject::Embree { tracer, .. } => tracer,
         }
@@ -164,6 +66,9 @@ impl Subject {
             #[cfg(feature = "embree")]
             if let Subject::Embree { tracer, packet } = self {
                 return trace_embree(tracer, *packet, set, p, m);
+            }
+            if let Subject::Single(t) = self {
+                return trace_single(t, set.query, p, m);
             }
             match set.query {
                 Query::Closest => {
@@ -196,6 +101,17 @@ impl Subject {
             }
         }
         Some(s)
+    }
+}
+
+/// One ray at a time through a tracer's single-ray entry points.
+fn trace_single(t: &dyn Tracer, query: Query, p: &RayPacket, m: LaneMask) -> u64 {
+    let lanes = (0..crate::tracer::LANES).filter(|l| m & (1 << l) != 0);
+    match query {
+        Query::Closest => lanes
+            .map(|l| t.intersect(&p.get(l)).map_or(0, |h| h.prim as u64))
+            .sum(),
+        Query::Occluded => lanes.filter(|&l| t.occluded(&p.get(l))).count() as u64,
     }
 }
 
@@ -236,15 +152,11 @@ fn trace_embree(
     p: &RayPacket,
     m: LaneMask,
 ) -> u64 {
-    let lanes = (0..crate::tracer::LANES).filter(|l| m & (1 << l) != 0);
     match (set.query, packet) {
-        (Query::Closest, false) => lanes
-            .map(|l| t.intersect(&p.get(l)).map_or(0, |h| h.prim as u64))
-            .sum(),
-        (Query::Occluded, false) => lanes.filter(|&l| t.occluded(&p.get(l))).count() as u64,
+        (query, false) => trace_single(t, query, p, m),
         (Query::Closest, true) => {
             let mut h = HitPacket::default();
-            if set.class == "primary" {
+            if set.coherent {
                 t.intersect_packet_coherent(p, m, &mut h);
             } else {
                 t.intersect_packet(p, m, &mut h);
@@ -256,10 +168,7 @@ fn trace_embree(
 }
 
 pub fn unknown_backend(name: &str) -> Error {
-    Error::Usage(format!(
-        "unknown backend `{name}` (known: {})",
-        BACKENDS.join(", ")
-    ))
+    backends::unknown(name)
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -275,12 +184,18 @@ pub struct RaysRow {
     pub seconds: f64,
     pub mrays_per_s: f64,
     pub ratio_to_obvhs: Option<f64>,
-    /// Mean active lanes per 16-wide box test (packet backend only).
+    /// Mean active lanes per 16-lane visit of a wide node (packet backend only).
     pub active_lane_fraction: Option<f64>,
-    /// Node visits per ray, counting each active lane of a packet test (packet backend only).
+    /// Wide-node visits per ray, counting each active lane of a packet visit (packet backend
+    /// only; each visit tests all of a node's up to 8 children).
     pub nodes_per_ray: Option<f64>,
-    /// Box-test instructions issued per ray: packet tests plus single-ray tests.
+    /// Wide-node visits issued per ray: packet visits plus single-ray visits.
     pub tests_per_ray: Option<f64>,
+    /// Fraction of node visits made by single rays (the hybrid tail).
+    pub single_fraction: Option<f64>,
+    /// Leaf tests (a block of up to 8 triangles, or a sphere) per ray, by packets or single
+    /// rays.
+    pub leaves_per_ray: Option<f64>,
 }
 
 /// Times every subject on every set: `rounds` rounds, the subject order reversed on odd
@@ -335,6 +250,10 @@ pub fn measure(
                     .map(|s| s.packet_lanes as f64 / (16 * s.packet_nodes.max(1)) as f64),
                 nodes_per_ray: st.map(|s| per_ray(s.packet_lanes + s.single_nodes)),
                 tests_per_ray: st.map(|s| per_ray(s.packet_nodes + s.single_nodes)),
+                single_fraction: st.map(|s| {
+                    s.single_nodes as f64 / (s.packet_nodes + s.single_nodes).max(1) as f64
+                }),
+                leaves_per_ray: st.map(|s| per_ray(s.leaves)),
             });
         }
     }

@@ -1,91 +1,147 @@
-//! Fixed, seeded ray sets drawn from a scene, for backend cross-checks and throughput runs:
-//! camera rays in 4×4 tiles, shadow rays to area-light samples, incoherent hemisphere rays.
-//! Every set is a flat list whose consecutive runs of 16 form the packets.
+//! The one generator of fixed, seeded ray sets drawn from a scene, for the throughput harness
+//! (`dibench rays`, the criterion benches) and the backend cross-check: camera rays through
+//! pixel centres in 4×4 tiles, and from each surface point a primary ray hits (found with the
+//! scene's own tracer, offset off the surface) a shadow ray to a light sample, a shadow ray
+//! towards a fixed distant direction, and a uniformly random direction into the hemisphere
+//! facing the camera. Secondary rays stay in their primary's packet lane, as the renderer
+//! groups them; a lane without a ray of that class is inactive.
 
 use crate::film::TileLayout;
 use crate::geometry::Ray;
+use crate::math::{mix64, offset_ray_origin};
 use crate::prepare::PreparedScene;
 use crate::render::camera_ray;
-use crate::sampling::stream::{SampleStream, name_id};
 use crate::sampling::warp::sample_uniform_sphere;
-use crate::strategy::ShadingPoint;
-use crate::tracer::LANES;
+use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
+use glam::Vec3;
 
-pub struct RaySet {
-    pub name: &'static str,
-    pub rays: Vec<Ray>,
-    /// Packets of this set are coherent (camera tiles), so backends may use a coherent kernel.
-    pub coherent: bool,
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Query {
+    Closest,
+    Occluded,
 }
 
+/// One ray class as 16-ray packets (4×4 pixel tiles) with their active masks.
+pub struct RaySet {
+    pub class: &'static str,
+    /// The class's natural query: occlusion for shadow rays, closest hit otherwise.
+    pub query: Query,
+    /// Packets of this set are coherent (camera tiles), so backends may use a coherent kernel.
+    pub coherent: bool,
+    pub packets: Vec<RayPacket>,
+    pub masks: Vec<LaneMask>,
+}
+
+/// The classes, in generation order.
+pub const CLASSES: [(&str, Query); 4] = [
+    ("primary", Query::Closest),
+    ("shadow_area", Query::Occluded),
+    ("shadow_distant", Query::Occluded),
+    ("incoherent", Query::Closest),
+];
+
 impl RaySet {
-    /// The rays as packets of up to 16 (the last one may be partial).
-    pub fn packets(&self) -> impl Iterator<Item = &[Ray]> {
-        self.rays.chunks(LANES)
+    /// Active rays.
+    pub fn rays(&self) -> u64 {
+        self.masks.iter().map(|m| m.count_ones() as u64).sum()
+    }
+
+    /// The active rays, packet by packet, lane by lane.
+    pub fn flat(&self) -> Vec<Ray> {
+        let mut out = Vec::with_capacity(self.rays() as usize);
+        for (p, &m) in self.packets.iter().zip(&self.masks) {
+            out.extend((0..LANES).filter(|l| m & (1 << l) != 0).map(|l| p.get(l)));
+        }
+        out
+    }
+
+    /// A set from a flat list: consecutive runs of 16 rays form the packets.
+    pub fn from_rays(class: &'static str, query: Query, coherent: bool, rays: &[Ray]) -> Self {
+        let mut set = RaySet {
+            class,
+            query,
+            coherent,
+            packets: vec![],
+            masks: vec![],
+        };
+        for chunk in rays.chunks(LANES) {
+            let mut p = RayPacket::default();
+            for (l, r) in chunk.iter().enumerate() {
+                p.set(l, r);
+            }
+            set.packets.push(p);
+            set.masks.push(((1u32 << chunk.len()) - 1) as LaneMask);
+        }
+        set
     }
 }
 
-pub const SET_NAMES: [&str; 3] = ["primary", "shadow_area", "incoherent"];
+/// Uniform [0, 1) from a hashed key: fixed ray sets without RNG state.
+fn u01(key: u64) -> f32 {
+    (mix64(key) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
+}
 
-/// Camera rays (one per pixel, jittered, tile by tile), then from each surface the primary rays
-/// hit (found with the scene's own tracer): a shadow ray to a light sample in front of the
-/// surface (finite tmax) and a uniformly random direction into the hemisphere facing the
-/// camera (infinite tmax). Shadow rays need a light with positive power; the set is empty
-/// otherwise.
-pub fn generate(scene: &PreparedScene, seed: u64) -> Vec<RaySet> {
-    let camera = &scene.scene.camera;
-    let (w, h) = (scene.scene.width, scene.scene.height);
-    let layout = TileLayout::new(w, h);
-    let mut primary = Vec::with_capacity((w * h) as usize);
-    let mut shadow = Vec::new();
-    let mut incoherent = Vec::new();
-    let salt = name_id("raysets");
+/// The four classes of [`CLASSES`] for a `width`×`height` image of the scene's camera.
+pub fn generate(scene: &PreparedScene, width: u32, height: u32, seed: u64) -> Vec<RaySet> {
+    let cam = &scene.scene.camera;
+    let layout = TileLayout::new(width, height);
+    let distant = Vec3::new(0.35, 1.0, 0.25).normalize();
+    let mut sets: Vec<RaySet> = CLASSES
+        .into_iter()
+        .map(|(class, query)| RaySet {
+            class,
+            query,
+            coherent: class == "primary",
+            packets: vec![],
+            masks: vec![],
+        })
+        .collect();
+    let mut hits = HitPacket::default();
     for tile in 0..layout.tile_count() {
+        let mut p = [RayPacket::default(); 4];
+        let mut m = [0 as LaneMask; 4];
         for lane in 0..LANES {
             if let Some((x, y)) = layout.lane_pixel(tile, lane) {
-                let pixel = y as u64 * w as u64 + x as u64;
-                let mut rng = SampleStream::new(seed, salt, pixel, 0);
-                primary.push((camera_ray(camera, w, h, x, y, rng.next_2d()), rng));
+                p[0].set(lane, &camera_ray(cam, width, height, x, y, [0.5, 0.5]));
+                m[0] |= 1 << lane;
+            }
+        }
+        scene.tracer.intersect_packet(&p[0], m[0], &mut hits);
+        for lane in 0..LANES {
+            let Some(hit) = hits.get(lane) else { continue };
+            let ray = p[0].get(lane);
+            let surf = scene.surface(&ray, &hit);
+            let n = if surf.ng.dot(ray.dir) < 0.0 {
+                surf.ng
+            } else {
+                -surf.ng
+            };
+            let o = offset_ray_origin(surf.p, surf.p_error, n);
+            let key = seed ^ ((tile as u64) << 4 | lane as u64) << 8;
+            let u = |i: u64| u01(key.wrapping_add(i));
+            if let Some((_, ls)) = scene.sample_light(
+                o,
+                u(1),
+                [u(2), u(3), u(4)],
+                &crate::lights::LightMethods::BASIC,
+            ) && let Some(r) = ls.shadow_ray(o)
+            {
+                p[1].set(lane, &r);
+                m[1] |= 1 << lane;
+            }
+            p[2].set(lane, &Ray::new(o, distant, f32::INFINITY));
+            m[2] |= 1 << lane;
+            let d = sample_uniform_sphere([u(5), u(6)]);
+            let d = if d.dot(n) < 0.0 { -d } else { d };
+            p[3].set(lane, &Ray::new(o, d, f32::INFINITY));
+            m[3] |= 1 << lane;
+        }
+        for k in 0..4 {
+            if m[k] != 0 {
+                sets[k].packets.push(p[k]);
+                sets[k].masks.push(m[k]);
             }
         }
     }
-    for (ray, rng) in &mut primary {
-        let Some(hit) = scene.tracer.intersect(ray) else {
-            continue;
-        };
-        let surf = scene.surface(ray, &hit);
-        let white = crate::bsdf::Bsdf::lambertian(glam::Vec3::ONE);
-        let sp = ShadingPoint::with_error(surf.p, surf.p_error, surf.ng, ray.dir, &white);
-        let u_select = rng.next_1d();
-        let u = [rng.next_1d(), rng.next_1d(), rng.next_1d()];
-        if let Some(r) = scene
-            .sample_light(sp.p, u_select, u, &crate::lights::LightMethods::BASIC)
-            .and_then(|(_, ls)| ls.shadow_ray(sp.origin))
-            // Only the rays a renderer traces: a light behind the surface is never tested
-            // (and the origin is offset to the front side only).
-            .filter(|r| r.dir.dot(sp.n) > 0.0)
-        {
-            shadow.push(r);
-        }
-        let d = sample_uniform_sphere(rng.next_2d());
-        let d = if d.dot(sp.n) < 0.0 { -d } else { d };
-        incoherent.push(Ray::new(sp.origin, d, f32::INFINITY));
-    }
-    vec![
-        RaySet {
-            name: SET_NAMES[0],
-            rays: primary.into_iter().map(|(r, _)| r).collect(),
-            coherent: true,
-        },
-        RaySet {
-            name: SET_NAMES[1],
-            rays: shadow,
-            coherent: false,
-        },
-        RaySet {
-            name: SET_NAMES[2],
-            rays: incoherent,
-            coherent: false,
-        },
-    ]
+    sets
 }

@@ -1,8 +1,8 @@
-//! AVX2: a 16-lane vector is two ymm registers (lanes 0–7, 8–15). FMA is deliberately not
-//! enabled, so the path rounds exactly like the others.
+//! AVX2: an 8-lane vector is one ymm register, a 16-lane vector two (lanes 0–7, 8–15). FMA is
+//! deliberately not enabled, so the path rounds exactly like the others.
 #![cfg(target_arch = "x86_64")]
 
-use super::{Kernel, Lanes, Mask, WIDTH};
+use super::{Kernel, Lanes, NARROW, Vector, WIDTH};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy)]
@@ -15,19 +15,19 @@ pub unsafe fn entry<K: Kernel>(k: K) -> K::Out {
     k.run::<Avx2>()
 }
 
+impl Lanes for Avx2 {
+    type V = Y2;
+    type W = Y;
+}
+
+/// 8 lanes in one ymm register; also the AVX-512 path's narrow vector. Only ever used inside
+/// an `avx2` or `avx512f` entry.
 #[derive(Clone, Copy)]
-pub struct V2(__m256, __m256);
+pub struct Y(__m256);
 
-macro_rules! both {
-    ($f:ident, $a:expr, $b:expr) => {
-        unsafe { V2($f($a.0, $b.0), $f($a.1, $b.1)) }
-    };
-}
-
-#[inline(always)]
-fn bits(lo: __m256, hi: __m256) -> Mask {
-    unsafe { (_mm256_movemask_ps(lo) as u32 | ((_mm256_movemask_ps(hi) as u32) << 8)) as Mask }
-}
+/// 16 lanes in two ymm registers.
+#[derive(Clone, Copy)]
+pub struct Y2(Y, Y);
 
 /// Expands 8 mask bits into all-ones / all-zeros lanes.
 #[inline(always)]
@@ -39,93 +39,142 @@ fn expand(m: u32) -> __m256 {
     }
 }
 
-impl Lanes for Avx2 {
-    type V = V2;
+macro_rules! op {
+    ($name:ident, $f:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            unsafe { Y($f(self.0, o.0)) }
+        }
+    };
+}
+
+macro_rules! cmp {
+    ($name:ident, $p:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> u32 {
+            unsafe { _mm256_movemask_ps(_mm256_cmp_ps::<$p>(self.0, o.0)) as u32 }
+        }
+    };
+}
+
+impl Vector<NARROW> for Y {
     #[inline(always)]
-    fn splat(x: f32) -> V2 {
-        unsafe { V2(_mm256_set1_ps(x), _mm256_set1_ps(x)) }
+    fn splat(x: f32) -> Self {
+        unsafe { Y(_mm256_set1_ps(x)) }
     }
     #[inline(always)]
-    fn load(a: &[f32; WIDTH]) -> V2 {
+    fn load(a: &[f32; NARROW]) -> Self {
+        unsafe { Y(_mm256_loadu_ps(a.as_ptr())) }
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [f32; NARROW]) {
+        unsafe { _mm256_storeu_ps(a.as_mut_ptr(), self.0) }
+    }
+    op!(add, _mm256_add_ps);
+    op!(sub, _mm256_sub_ps);
+    op!(mul, _mm256_mul_ps);
+    op!(div, _mm256_div_ps);
+    op!(min, _mm256_min_ps);
+    op!(max, _mm256_max_ps);
+    #[inline(always)]
+    fn abs(self) -> Self {
+        unsafe { Y(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
+    }
+    cmp!(lt, _CMP_LT_OQ);
+    cmp!(le, _CMP_LE_OQ);
+    cmp!(eq, _CMP_EQ_OQ);
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        unsafe { _mm256_movemask_ps(self.0) as u32 }
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        unsafe { Y(_mm256_blendv_ps(b.0, a.0, expand(m))) }
+    }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
         unsafe {
-            V2(
-                _mm256_loadu_ps(a.as_ptr()),
-                _mm256_loadu_ps(a.as_ptr().add(8)),
-            )
+            let v = _mm256_min_ps(self.0, _mm256_permute2f128_ps::<1>(self.0, self.0));
+            let v = _mm256_min_ps(v, _mm256_shuffle_ps::<0b0100_1110>(v, v));
+            let v = _mm256_min_ps(v, _mm256_shuffle_ps::<0b1011_0001>(v, v));
+            _mm256_cvtss_f32(v)
         }
     }
     #[inline(always)]
-    fn store(v: V2, a: &mut [f32; WIDTH]) {
+    fn reduce_max(self) -> f32 {
         unsafe {
-            _mm256_storeu_ps(a.as_mut_ptr(), v.0);
-            _mm256_storeu_ps(a.as_mut_ptr().add(8), v.1);
+            let v = _mm256_max_ps(self.0, _mm256_permute2f128_ps::<1>(self.0, self.0));
+            let v = _mm256_max_ps(v, _mm256_shuffle_ps::<0b0100_1110>(v, v));
+            let v = _mm256_max_ps(v, _mm256_shuffle_ps::<0b1011_0001>(v, v));
+            _mm256_cvtss_f32(v)
         }
     }
-    #[inline(always)]
-    fn add(a: V2, b: V2) -> V2 {
-        both!(_mm256_add_ps, a, b)
-    }
-    #[inline(always)]
-    fn sub(a: V2, b: V2) -> V2 {
-        both!(_mm256_sub_ps, a, b)
-    }
-    #[inline(always)]
-    fn mul(a: V2, b: V2) -> V2 {
-        both!(_mm256_mul_ps, a, b)
-    }
-    #[inline(always)]
-    fn div(a: V2, b: V2) -> V2 {
-        both!(_mm256_div_ps, a, b)
-    }
-    #[inline(always)]
-    fn min(a: V2, b: V2) -> V2 {
-        both!(_mm256_min_ps, a, b)
-    }
-    #[inline(always)]
-    fn max(a: V2, b: V2) -> V2 {
-        both!(_mm256_max_ps, a, b)
-    }
-    #[inline(always)]
-    fn abs(a: V2) -> V2 {
-        unsafe {
-            let sign = _mm256_set1_ps(-0.0);
-            V2(_mm256_andnot_ps(sign, a.0), _mm256_andnot_ps(sign, a.1))
+}
+
+macro_rules! both {
+    ($name:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            Y2(self.0.$name(o.0), self.1.$name(o.1))
         }
+    };
+}
+
+macro_rules! both_cmp {
+    ($name:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> u32 {
+            self.0.$name(o.0) | (self.1.$name(o.1) << 8)
+        }
+    };
+}
+
+impl Vector<WIDTH> for Y2 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Y2(Y::splat(x), Y::splat(x))
     }
     #[inline(always)]
-    fn lt(a: V2, b: V2) -> Mask {
-        unsafe {
-            bits(
-                _mm256_cmp_ps::<_CMP_LT_OQ>(a.0, b.0),
-                _mm256_cmp_ps::<_CMP_LT_OQ>(a.1, b.1),
-            )
-        }
+    fn load(a: &[f32; WIDTH]) -> Self {
+        let (lo, hi) = a.split_at(NARROW);
+        Y2(
+            Y::load(lo.try_into().unwrap()),
+            Y::load(hi.try_into().unwrap()),
+        )
     }
     #[inline(always)]
-    fn le(a: V2, b: V2) -> Mask {
-        unsafe {
-            bits(
-                _mm256_cmp_ps::<_CMP_LE_OQ>(a.0, b.0),
-                _mm256_cmp_ps::<_CMP_LE_OQ>(a.1, b.1),
-            )
-        }
+    fn store(self, a: &mut [f32; WIDTH]) {
+        let (lo, hi) = a.split_at_mut(NARROW);
+        self.0.store(lo.try_into().unwrap());
+        self.1.store(hi.try_into().unwrap());
+    }
+    both!(add);
+    both!(sub);
+    both!(mul);
+    both!(div);
+    both!(min);
+    both!(max);
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Y2(self.0.abs(), self.1.abs())
+    }
+    both_cmp!(lt);
+    both_cmp!(le);
+    both_cmp!(eq);
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        self.0.sign() | (self.1.sign() << 8)
     }
     #[inline(always)]
-    fn eq(a: V2, b: V2) -> Mask {
-        unsafe {
-            bits(
-                _mm256_cmp_ps::<_CMP_EQ_OQ>(a.0, b.0),
-                _mm256_cmp_ps::<_CMP_EQ_OQ>(a.1, b.1),
-            )
-        }
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        Y2(Y::select(m & 0xff, a.0, b.0), Y::select(m >> 8, a.1, b.1))
     }
     #[inline(always)]
-    fn select(m: Mask, a: V2, b: V2) -> V2 {
-        unsafe {
-            V2(
-                _mm256_blendv_ps(b.0, a.0, expand(m as u32 & 0xff)),
-                _mm256_blendv_ps(b.1, a.1, expand(m as u32 >> 8)),
-            )
-        }
+    fn reduce_min(self) -> f32 {
+        self.0.min(self.1).reduce_min()
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        self.0.max(self.1).reduce_max()
     }
 }

@@ -1,7 +1,9 @@
-//! AVX-512F: one zmm register per 16 lanes, comparisons straight into k-masks.
+//! AVX-512F: one zmm register per 16 lanes, comparisons straight into k-masks; the 8-lane
+//! vector is the AVX2 path's ymm type (avx512f implies avx2), compiled here with AVX-512 enabled.
 #![cfg(target_arch = "x86_64")]
 
-use super::{Kernel, Lanes, Mask, WIDTH};
+use super::avx2::Y;
+use super::{Kernel, Lanes, Vector, WIDTH};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy)]
@@ -18,62 +20,78 @@ pub unsafe fn entry<K: Kernel>(k: K) -> K::Out {
 }
 
 impl Lanes for Avx512 {
-    type V = __m512;
+    type V = Z;
+    type W = Y;
+}
+
+#[derive(Clone, Copy)]
+pub struct Z(__m512);
+
+macro_rules! op {
+    ($name:ident, $f:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            unsafe { Z($f(self.0, o.0)) }
+        }
+    };
+}
+
+macro_rules! cmp {
+    ($name:ident, $p:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> u32 {
+            unsafe { _mm512_cmp_ps_mask::<$p>(self.0, o.0) as u32 }
+        }
+    };
+}
+
+impl Vector<WIDTH> for Z {
     #[inline(always)]
-    fn splat(x: f32) -> __m512 {
-        unsafe { _mm512_set1_ps(x) }
+    fn splat(x: f32) -> Self {
+        unsafe { Z(_mm512_set1_ps(x)) }
     }
     #[inline(always)]
-    fn load(a: &[f32; WIDTH]) -> __m512 {
-        unsafe { _mm512_loadu_ps(a.as_ptr()) }
+    fn load(a: &[f32; WIDTH]) -> Self {
+        unsafe { Z(_mm512_loadu_ps(a.as_ptr())) }
     }
     #[inline(always)]
-    fn store(v: __m512, a: &mut [f32; WIDTH]) {
-        unsafe { _mm512_storeu_ps(a.as_mut_ptr(), v) }
+    fn store(self, a: &mut [f32; WIDTH]) {
+        unsafe { _mm512_storeu_ps(a.as_mut_ptr(), self.0) }
+    }
+    op!(add, _mm512_add_ps);
+    op!(sub, _mm512_sub_ps);
+    op!(mul, _mm512_mul_ps);
+    op!(div, _mm512_div_ps);
+    op!(min, _mm512_min_ps);
+    op!(max, _mm512_max_ps);
+    #[inline(always)]
+    fn abs(self) -> Self {
+        unsafe { Z(_mm512_abs_ps(self.0)) }
+    }
+    cmp!(lt, _CMP_LT_OQ);
+    cmp!(le, _CMP_LE_OQ);
+    cmp!(eq, _CMP_EQ_OQ);
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        sign_bits(self.0)
     }
     #[inline(always)]
-    fn add(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_add_ps(a, b) }
-    }
-    #[inline(always)]
-    fn sub(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_sub_ps(a, b) }
-    }
-    #[inline(always)]
-    fn mul(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_mul_ps(a, b) }
-    }
-    #[inline(always)]
-    fn div(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_div_ps(a, b) }
-    }
-    #[inline(always)]
-    fn min(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_min_ps(a, b) }
-    }
-    #[inline(always)]
-    fn max(a: __m512, b: __m512) -> __m512 {
-        unsafe { _mm512_max_ps(a, b) }
-    }
-    #[inline(always)]
-    fn abs(a: __m512) -> __m512 {
-        unsafe { _mm512_abs_ps(a) }
-    }
-    #[inline(always)]
-    fn lt(a: __m512, b: __m512) -> Mask {
-        unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b) }
-    }
-    #[inline(always)]
-    fn le(a: __m512, b: __m512) -> Mask {
-        unsafe { _mm512_cmp_ps_mask::<_CMP_LE_OQ>(a, b) }
-    }
-    #[inline(always)]
-    fn eq(a: __m512, b: __m512) -> Mask {
-        unsafe { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b) }
-    }
-    #[inline(always)]
-    fn select(m: Mask, a: __m512, b: __m512) -> __m512 {
+    fn select(m: u32, a: Self, b: Self) -> Self {
         // mask_blend takes the second operand where the bit is set.
-        unsafe { _mm512_mask_blend_ps(m, b, a) }
+        unsafe { Z(_mm512_mask_blend_ps(m as __mmask16, b.0, a.0)) }
     }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        unsafe { _mm512_reduce_min_ps(self.0) }
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        unsafe { _mm512_reduce_max_ps(self.0) }
+    }
+}
+
+/// Sign bits of 16 lanes (avx512f has no movmskps for zmm: compare as integers against 0).
+#[inline(always)]
+fn sign_bits(v: __m512) -> u32 {
+    unsafe { _mm512_cmplt_epi32_mask(_mm512_castps_si512(v), _mm512_setzero_si512()) as u32 }
 }

@@ -1,7 +1,9 @@
-//! The lane layer: a 16-lane f32 vector that runs as 1×16 on AVX-512, 2×8 on AVX2 and as a
-//! plain array elsewhere. This module is the only place that touches `std::arch`; kernels are
-//! written once, generic over [`Lanes`], and monomorphised inside one `#[target_feature]`
-//! entry per ISA ([`run`]), so every intrinsic inlines into the whole kernel.
+//! The lane layer: f32 vectors of 16 lanes (a ray packet: 1×16 on AVX-512, 2×8 on AVX2) and of
+//! 8 lanes (one single ray against the 8 children of a wide node or an 8-triangle leaf block:
+//! one ymm register on both AVX2 and AVX-512), and plain arrays elsewhere. This module is the
+//! only place that touches `std::arch`; kernels are written once, generic over [`Lanes`], and
+//! monomorphised inside one `#[target_feature]` entry per ISA ([`run`]), so every intrinsic
+//! inlines into the whole kernel (no intrinsic is left as an out-of-line call).
 //!
 //! All paths perform the same IEEE operations in the same order (no FMA anywhere, min/max
 //! with MINPS/MAXPS semantics), so results are bit-identical across ISAs.
@@ -13,36 +15,52 @@ mod portable;
 
 pub use isa::Isa;
 
-/// Lane count of a packet.
+/// Lane count of a packet: one 4×4 pixel tile (see the assertion in `tracer`).
 pub const WIDTH: usize = 16;
 
-/// Bit i = lane i.
+/// Lane count of the narrow vector: children of a wide BVH node, triangles of a leaf block.
+pub const NARROW: usize = 8;
+
+/// Bit i = lane i of a 16-lane vector.
 pub type Mask = u16;
 
-/// 16 f32 lanes. Static functions on a zero-sized type, so a kernel names its ISA once.
-pub trait Lanes: Copy {
-    type V: Copy;
-    fn splat(x: f32) -> Self::V;
-    fn load(a: &[f32; WIDTH]) -> Self::V;
-    fn store(v: Self::V, a: &mut [f32; WIDTH]);
-    fn add(a: Self::V, b: Self::V) -> Self::V;
-    fn sub(a: Self::V, b: Self::V) -> Self::V;
-    fn mul(a: Self::V, b: Self::V) -> Self::V;
-    fn div(a: Self::V, b: Self::V) -> Self::V;
+/// An f32 vector of `N` lanes. Comparisons return one bit per lane (bit i = lane i).
+pub trait Vector<const N: usize>: Copy {
+    fn splat(x: f32) -> Self;
+    fn load(a: &[f32; N]) -> Self;
+    fn store(self, a: &mut [f32; N]);
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn mul(self, o: Self) -> Self;
+    fn div(self, o: Self) -> Self;
     /// `if a < b { a } else { b }` per lane (MINPS semantics).
-    fn min(a: Self::V, b: Self::V) -> Self::V;
+    fn min(self, o: Self) -> Self;
     /// `if a > b { a } else { b }` per lane (MAXPS semantics).
-    fn max(a: Self::V, b: Self::V) -> Self::V;
-    fn abs(a: Self::V) -> Self::V;
-    /// Ordered comparisons (false on NaN), one bit per lane.
-    fn lt(a: Self::V, b: Self::V) -> Mask;
-    fn le(a: Self::V, b: Self::V) -> Mask;
-    fn eq(a: Self::V, b: Self::V) -> Mask;
+    fn max(self, o: Self) -> Self;
+    fn abs(self) -> Self;
+    /// Ordered comparisons (false on NaN).
+    fn lt(self, o: Self) -> u32;
+    fn le(self, o: Self) -> u32;
+    fn eq(self, o: Self) -> u32;
+    /// Lanes whose sign bit is set (-0.0 included).
+    fn sign(self) -> u32;
     /// Lane i = `a` where bit i of `m` is set, else `b`.
-    fn select(m: Mask, a: Self::V, b: Self::V) -> Self::V;
+    fn select(m: u32, a: Self, b: Self) -> Self;
+    /// The smallest lane (for NaN-free lanes the result does not depend on the order).
+    fn reduce_min(self) -> f32;
+    /// The largest lane (likewise).
+    fn reduce_max(self) -> f32;
 }
 
-/// A computation generic over the lane type; [`run`] instantiates it for one ISA.
+/// One ISA's vector types. A zero-sized type, so a kernel names its ISA once.
+pub trait Lanes: Copy {
+    /// 16 lanes: a packet.
+    type V: Vector<WIDTH>;
+    /// 8 lanes: a wide node's children or a leaf block's triangles.
+    type W: Vector<NARROW>;
+}
+
+/// A computation generic over the lane types; [`run`] instantiates it for one ISA.
 pub trait Kernel {
     type Out;
     fn run<L: Lanes>(self) -> Self::Out;
@@ -71,38 +89,67 @@ pub fn run<K: Kernel>(isa: Isa, k: K) -> K::Out {
 mod tests {
     use super::*;
 
-    struct Probe([f32; WIDTH], [f32; WIDTH]);
+    struct Probe<const N: usize>([f32; N], [f32; N]);
 
-    impl Kernel for Probe {
-        type Out = (Vec<[f32; WIDTH]>, Vec<Mask>);
+    fn probe<V: Vector<N>, const N: usize>(a: [f32; N], b: [f32; N]) -> (Vec<[f32; N]>, Vec<u32>) {
+        let (x, y) = (V::load(&a), V::load(&b));
+        let vs = [
+            x.add(y),
+            x.sub(y),
+            x.mul(y),
+            x.div(y),
+            x.min(y),
+            x.max(y),
+            x.abs(),
+            V::select(0b1010_0101_1100_0011 & ((1u64 << N) - 1) as u32, x, y),
+            V::splat(a[1]),
+            V::splat(x.reduce_min()),
+            V::splat(y.reduce_max()),
+        ];
+        let out = vs
+            .iter()
+            .map(|&v| {
+                let mut o = [0.0; N];
+                v.store(&mut o);
+                o
+            })
+            .collect();
+        (out, vec![x.lt(y), x.le(y), x.eq(y), x.sign()])
+    }
+
+    impl<const N: usize> Kernel for Probe<N> {
+        type Out = [(Vec<[f32; N]>, Vec<u32>); 2];
         fn run<L: Lanes>(self) -> Self::Out {
-            let (a, b) = (L::load(&self.0), L::load(&self.1));
-            let vs = [
-                L::add(a, b),
-                L::sub(a, b),
-                L::mul(a, b),
-                L::div(a, b),
-                L::min(a, b),
-                L::max(a, b),
-                L::abs(a),
-                L::select(0b1010_0101_1100_0011, a, b),
-            ];
-            let out = vs
-                .iter()
-                .map(|&v| {
-                    let mut o = [0.0; WIDTH];
-                    L::store(v, &mut o);
-                    o
-                })
-                .collect();
-            (out, vec![L::lt(a, b), L::le(a, b), L::eq(a, b)])
+            let wide = {
+                let a: [f32; WIDTH] = std::array::from_fn(|i| self.0[i % N]);
+                let b: [f32; WIDTH] = std::array::from_fn(|i| self.1[i % N]);
+                let (v, m) = probe::<L::V, WIDTH>(a, b);
+                (v.iter().map(|x| std::array::from_fn(|i| x[i])).collect(), m)
+            };
+            let narrow = {
+                let a: [f32; NARROW] = std::array::from_fn(|i| self.0[i % N]);
+                let b: [f32; NARROW] = std::array::from_fn(|i| self.1[i % N]);
+                let (v, m) = probe::<L::W, NARROW>(a, b);
+                (
+                    v.iter()
+                        .map(|x| std::array::from_fn(|i| x[i % NARROW]))
+                        .collect(),
+                    m,
+                )
+            };
+            [wide, narrow]
         }
     }
 
-    /// Every available ISA gives bit-identical results to the portable path.
+    /// Every available ISA gives bit-identical results to the portable path, at both widths.
     #[test]
     fn isas_agree_bit_for_bit() {
-        let a: [f32; WIDTH] = std::array::from_fn(|i| (i as f32 - 7.5) * 0.37);
+        let a: [f32; WIDTH] = std::array::from_fn(|i| match i {
+            3 => -0.0,
+            5 => f32::INFINITY,
+            6 => -9.5,
+            _ => (i as f32 - 7.5) * 0.37,
+        });
         let b: [f32; WIDTH] = std::array::from_fn(|i| {
             if i % 3 == 0 {
                 a[i]
@@ -111,17 +158,21 @@ mod tests {
             }
         });
         let want = run(Isa::Portable, Probe(a, b));
-        assert_eq!(want.1[2].count_ones(), 6);
+        assert_eq!(want[0].1[2].count_ones(), 6);
+        assert_eq!(want[0].1[3] & 0b1000, 0b1000, "-0.0 has its sign bit");
+        assert_eq!(want[0].0[9][0], -9.5, "reduce_min");
         for isa in Isa::available() {
             let got = run(isa, Probe(a, b));
-            for (x, y) in got.0.iter().zip(&want.0) {
-                let (x, y): (Vec<u32>, Vec<u32>) = (
-                    x.iter().map(|f| f.to_bits()).collect(),
-                    y.iter().map(|f| f.to_bits()).collect(),
-                );
-                assert_eq!(x, y, "{isa:?}");
+            for (g, w) in got.iter().zip(&want) {
+                for (x, y) in g.0.iter().zip(&w.0) {
+                    let (x, y): (Vec<u32>, Vec<u32>) = (
+                        x.iter().map(|f| f.to_bits()).collect(),
+                        y.iter().map(|f| f.to_bits()).collect(),
+                    );
+                    assert_eq!(x, y, "{isa:?}");
+                }
+                assert_eq!(g.1, w.1, "{isa:?}");
             }
-            assert_eq!(got.1, want.1, "{isa:?}");
         }
     }
 }

@@ -1,82 +1,111 @@
 //! The portable path: plain arrays, scalar code with the same semantics as the SIMD paths.
 
-use super::{Lanes, Mask, WIDTH};
+use super::{Lanes, NARROW, Vector, WIDTH};
 
 #[derive(Clone, Copy)]
 pub struct Portable;
 
-type V = [f32; WIDTH];
-
-#[inline(always)]
-fn map2(a: V, b: V, f: impl Fn(f32, f32) -> f32) -> V {
-    std::array::from_fn(|i| f(a[i], b[i]))
-}
-
-#[inline(always)]
-fn cmp(a: V, b: V, f: impl Fn(f32, f32) -> bool) -> Mask {
-    let mut m = 0;
-    for i in 0..WIDTH {
-        m |= (f(a[i], b[i]) as Mask) << i;
-    }
-    m
-}
-
 impl Lanes for Portable {
-    type V = V;
+    type V = P<WIDTH>;
+    type W = P<NARROW>;
+}
+
+#[derive(Clone, Copy)]
+pub struct P<const N: usize>([f32; N]);
+
+impl<const N: usize> P<N> {
     #[inline(always)]
-    fn splat(x: f32) -> V {
-        [x; WIDTH]
+    fn map2(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+        P(std::array::from_fn(|i| f(self.0[i], o.0[i])))
+    }
+
+    #[inline(always)]
+    fn bits(self, o: Self, f: impl Fn(f32, f32) -> bool) -> u32 {
+        let mut m = 0;
+        for i in 0..N {
+            m |= (f(self.0[i], o.0[i]) as u32) << i;
+        }
+        m
+    }
+}
+
+impl<const N: usize> Vector<N> for P<N> {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        P([x; N])
     }
     #[inline(always)]
-    fn load(a: &V) -> V {
-        *a
+    fn load(a: &[f32; N]) -> Self {
+        P(*a)
     }
     #[inline(always)]
-    fn store(v: V, a: &mut V) {
-        *a = v;
+    fn store(self, a: &mut [f32; N]) {
+        *a = self.0;
     }
     #[inline(always)]
-    fn add(a: V, b: V) -> V {
-        map2(a, b, |x, y| x + y)
+    fn add(self, o: Self) -> Self {
+        self.map2(o, |x, y| x + y)
     }
     #[inline(always)]
-    fn sub(a: V, b: V) -> V {
-        map2(a, b, |x, y| x - y)
+    fn sub(self, o: Self) -> Self {
+        self.map2(o, |x, y| x - y)
     }
     #[inline(always)]
-    fn mul(a: V, b: V) -> V {
-        map2(a, b, |x, y| x * y)
+    fn mul(self, o: Self) -> Self {
+        self.map2(o, |x, y| x * y)
     }
     #[inline(always)]
-    fn div(a: V, b: V) -> V {
-        map2(a, b, |x, y| x / y)
+    fn div(self, o: Self) -> Self {
+        self.map2(o, |x, y| x / y)
     }
     #[inline(always)]
-    fn min(a: V, b: V) -> V {
-        map2(a, b, |x, y| if x < y { x } else { y })
+    fn min(self, o: Self) -> Self {
+        self.map2(o, |x, y| if x < y { x } else { y })
     }
     #[inline(always)]
-    fn max(a: V, b: V) -> V {
-        map2(a, b, |x, y| if x > y { x } else { y })
+    fn max(self, o: Self) -> Self {
+        self.map2(o, |x, y| if x > y { x } else { y })
     }
     #[inline(always)]
-    fn abs(a: V) -> V {
-        a.map(f32::abs)
+    fn abs(self) -> Self {
+        P(self.0.map(f32::abs))
     }
     #[inline(always)]
-    fn lt(a: V, b: V) -> Mask {
-        cmp(a, b, |x, y| x < y)
+    fn lt(self, o: Self) -> u32 {
+        self.bits(o, |x, y| x < y)
     }
     #[inline(always)]
-    fn le(a: V, b: V) -> Mask {
-        cmp(a, b, |x, y| x <= y)
+    fn le(self, o: Self) -> u32 {
+        self.bits(o, |x, y| x <= y)
     }
     #[inline(always)]
-    fn eq(a: V, b: V) -> Mask {
-        cmp(a, b, |x, y| x == y)
+    fn eq(self, o: Self) -> u32 {
+        self.bits(o, |x, y| x == y)
     }
     #[inline(always)]
-    fn select(m: Mask, a: V, b: V) -> V {
-        std::array::from_fn(|i| if m & (1 << i) != 0 { a[i] } else { b[i] })
+    fn sign(self) -> u32 {
+        self.bits(self, |x, _| x.is_sign_negative())
+    }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        let mut m = self.0[0];
+        for &x in &self.0[1..] {
+            m = if x < m { x } else { m };
+        }
+        m
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        let mut m = self.0[0];
+        for &x in &self.0[1..] {
+            m = if x > m { x } else { m };
+        }
+        m
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        P(std::array::from_fn(|i| {
+            if m & (1 << i) != 0 { a.0[i] } else { b.0[i] }
+        }))
     }
 }

@@ -41,16 +41,21 @@ pub fn build_isa(name: &str, geometry: Arc<Geometry>, isa: Option<Isa>) -> Resul
         }
         #[cfg(feature = "embree")]
         "embree" => Ok(Box::new(super::embree::EmbreeTracer::build(geometry)?)),
-        _ => Err(Error::Usage(format!(
-            "unknown backend `{name}` (available: {}{})",
-            AVAILABLE.join(", "),
-            if cfg!(feature = "embree") {
-                ""
-            } else {
-                "; `embree` needs scripts/setup-embree.sh and --features embree"
-            }
-        ))),
+        _ => Err(unknown(name)),
     }
+}
+
+/// The error for a backend name that is not compiled in, listing the available ones.
+pub fn unknown(name: &str) -> Error {
+    Error::Usage(format!(
+        "unknown backend `{name}` (available: {}{})",
+        AVAILABLE.join(", "),
+        if cfg!(feature = "embree") {
+            ""
+        } else {
+            "; `embree` needs scripts/setup-embree.sh and --features embree"
+        }
+    ))
 }
 
 /// Checks a backend name without building anything.

@@ -1,8 +1,8 @@
 //! The baseline backend: a BVH2 built by obvhs (PLOC) over triangles and analytic spheres,
-//! traversed by obvhs's single-ray kernels with our exact primitive tests in the leaves.
-//! Packets go through the trait's per-lane loop.
+//! traversed by obvhs's single-ray kernels with our exact primitive tests in the leaves and the
+//! contract's closest-hit rule ([`super::closer`]). Packets go through the trait's per-lane loop.
 
-use super::{Geometry, Tracer};
+use super::{Geometry, Tracer, closer, cull_t};
 use crate::geometry::triangle::WatertightRay;
 use crate::geometry::{Hit, Ray};
 use obvhs::aabb::Aabb;
@@ -27,32 +27,36 @@ impl Boundable for PrimBounds {
     }
 }
 
+/// Primitive boxes in id order: triangles, then spheres (the ids of [`Geometry`]).
+pub fn prim_bounds(geometry: &Geometry) -> Vec<Aabb> {
+    let mut bounds: Vec<Aabb> = geometry
+        .triangles
+        .iter()
+        .map(|t| {
+            let (a, b, c) = (t.v0.into(), t.v1.into(), t.v2.into());
+            Aabb::new(glam::Vec3A::min(a, b).min(c), glam::Vec3A::max(a, b).max(c))
+        })
+        .collect();
+    bounds.extend(geometry.spheres.iter().map(|s| {
+        let r = glam::Vec3A::splat(s.radius);
+        Aabb::new(
+            glam::Vec3A::from(s.center) - r,
+            glam::Vec3A::from(s.center) + r,
+        )
+    }));
+    bounds
+}
+
+/// obvhs's binary tree (PLOC) over the primitive boxes, with a build preset.
+pub fn build_bvh2(geometry: &Geometry, preset: BvhBuildParams) -> Bvh2 {
+    let bounds: Vec<PrimBounds> = prim_bounds(geometry).into_iter().map(PrimBounds).collect();
+    let mut core = std::time::Duration::ZERO;
+    obvhs::bvh2::builder::build_bvh2(&bounds, preset, &mut core)
+}
+
 impl ObvhsTracer {
     pub fn build(geometry: Arc<Geometry>) -> Self {
-        let mut bounds: Vec<PrimBounds> = geometry
-            .triangles
-            .iter()
-            .map(|t| {
-                let (a, b, c) = (t.v0.into(), t.v1.into(), t.v2.into());
-                PrimBounds(Aabb::new(
-                    glam::Vec3A::min(a, b).min(c),
-                    glam::Vec3A::max(a, b).max(c),
-                ))
-            })
-            .collect();
-        bounds.extend(geometry.spheres.iter().map(|s| {
-            let r = glam::Vec3A::splat(s.radius);
-            PrimBounds(Aabb::new(
-                glam::Vec3A::from(s.center) - r,
-                glam::Vec3A::from(s.center) + r,
-            ))
-        }));
-        let mut build_time = std::time::Duration::ZERO;
-        let bvh = obvhs::bvh2::builder::build_bvh2(
-            &bounds,
-            BvhBuildParams::medium_build(),
-            &mut build_time,
-        );
+        let bvh = build_bvh2(&geometry, BvhBuildParams::medium_build());
         let slot_prim = bvh.primitive_indices.clone();
         ObvhsTracer {
             geometry,
@@ -109,14 +113,17 @@ impl Tracer for ObvhsTracer {
         };
         let mut hit = RayHit::none();
         self.bvh
-            .ray_traverse(Self::to_bvh_ray(ray), &mut hit, |r, slot| {
+            .ray_traverse(Self::to_bvh_ray(ray), &mut hit, |_, slot| {
                 let prim = self.slot_prim[slot];
-                // Leaves are tested against the shrinking closest distance obvhs keeps in r.tmax.
-                let (t, u, v) = self.hit_prim(&Ray::new(ray.origin, ray.dir, r.tmax), &wr, prim);
-                if t < best.t {
+                // The contract's rule (`tracer::closer`): leaves are tested a little past the
+                // closest hit so far, so a tie is seen, and the smallest (t, prim) is kept.
+                let tm = cull_t(best.t).min(ray.tmax);
+                let (t, u, v) = self.hit_prim(&Ray::new(ray.origin, ray.dir, tm), &wr, prim);
+                if t < ray.tmax && closer(t, prim, best.t, best.prim) {
                     best = Hit { t, prim, u, v };
                 }
-                t
+                // obvhs culls boxes entered at or beyond the value returned here.
+                cull_t(best.t)
             });
         (best.prim != u32::MAX).then_some(best)
     }

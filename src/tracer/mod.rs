@@ -13,7 +13,13 @@ use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
 use glam::Vec3;
 
-pub const LANES: usize = 16;
+/// Rays per packet: one 4×4 pixel tile, one 16-lane vector of the SIMD layer.
+pub const LANES: usize = crate::simd::WIDTH;
+
+const _: () = assert!(
+    LANES == (crate::film::TILE * crate::film::TILE) as usize,
+    "a packet is one film tile"
+);
 
 /// Bit i set = lane i active.
 pub type LaneMask = u16;
@@ -134,6 +140,28 @@ impl Geometry {
     pub fn sphere_index(&self, prim: u32) -> Option<usize> {
         (prim as usize).checked_sub(self.triangles.len())
     }
+}
+
+/// The closest-hit rule every backend we own follows: among the primitives our exact tests hit
+/// on (0, tmax), the smallest t, and on equal t the smallest primitive id. It makes the answer
+/// independent of the tree and of the order a traversal meets the primitives in, so the
+/// `obvhs` and `packet` backends (every ISA, single rays and packets) agree bit for bit, ties
+/// on shared edges included.
+#[inline(always)]
+pub fn closer(t: f32, prim: u32, best_t: f32, best_prim: u32) -> bool {
+    t < best_t || (t == best_t && prim < best_prim)
+}
+
+/// Relative slack of [`cull_t`]: 2⁻²⁰, far above the few roundings between a box's entry
+/// distance and a triangle's computed t, far below anything a traversal would notice.
+pub const CULL_SCALE: f32 = 1.0 + 1.0 / (1u32 << 20) as f32;
+
+/// The distance beyond which a closest-hit traversal may skip boxes and reject triangles, given
+/// the closest hit so far: a little past it, so that a hit at the same t (a tie the rule above
+/// may still prefer) or one rounding away is never culled.
+#[inline(always)]
+pub fn cull_t(best_t: f32) -> f32 {
+    best_t * CULL_SCALE
 }
 
 pub trait Tracer: Send + Sync {

@@ -1,220 +1,530 @@
-//! The 16-ray packet kernels, generic over [`Lanes`]: one SIMD slab test per visited node
-//! for all active lanes, a (node, lane-mask) stack, and the watertight triangle test of Woop
-//! et al. (JCGT 2013) evaluated across lanes with a per-lane axis permutation.
+//! The 16-ray packet kernels over the wide BVH, generic over [`Lanes`]: per visited node one
+//! 16-lane slab test per child for the active lanes, a (child, lane-mask) stack, children
+//! pushed far to near by the entry distance of their first active lane, and the watertight
+//! triangle test across lanes. A node reached by fewer than [`super::HYBRID_LANES`] lanes (a
+//! leaf by fewer than [`super::LEAF_LANES`]) is finished one ray at a time (Benthin et al.
+//! 2012).
+//!
+//! Packet set-up is vectorised, and what the lanes share is used: a shared origin (camera
+//! rays) turns `box − origin` into scalar work, shared direction signs pick near/far planes
+//! without min/max, and a shared axis permutation (most coherent packets) drops the per-lane
+//! shuffles of the triangle test. Every variant computes the same values as the general one.
 
-use super::single::{self, Best, prim_hit};
-use super::{FAR_SCALE, HYBRID_LANES, Node, PacketTracer, STACK, TraceStats, safe_inv};
+use super::build::{Block, Child, Kind, MAX_ROW, Node};
+use super::leaf::{self, Out, Sheared};
+use super::{Best, FAR_SCALE, FAULT_FAR_FIRST, PacketTracer, Ray1, STACK, TraceStats, single};
 use crate::geometry::Ray;
-use crate::geometry::triangle::{Triangle, WatertightRay};
-use crate::simd::{Kernel, Lanes, Mask, WIDTH};
-use crate::tracer::{HitPacket, LaneMask, RayPacket};
+use crate::simd::{Kernel, Lanes, Mask, NARROW, Vector, WIDTH};
+use crate::tracer::{CULL_SCALE, HitPacket, LaneMask, NO_HIT, RayPacket};
+use std::mem::MaybeUninit;
 
-/// Per-packet constants, computed once per lane in scalar code.
-struct Prep {
-    o: [[f32; WIDTH]; 3],
+const FULL: u32 = (1 << WIDTH) - 1;
+
+/// Per-packet constants, computed across lanes with the scalar set-up's operations.
+struct Prep<V> {
+    o: [V; 3],
+    inv: [V; 3],
+    shear: [V; 3],
+    /// `kmask[j][c]`: lanes whose j-th permuted axis (kx, ky, kz) is c (c = 0, 1; else 2).
+    kmask: [[u32; 2]; 3],
+    /// The permutation when every active lane shares it.
+    uniform: Option<[usize; 3]>,
+    /// The origin when every active lane shares it (bit for bit).
+    origin: [f32; 3],
+    /// Lanes whose direction is negative along their dominant axis.
+    neg: u32,
+    /// Near-plane row per axis when every active lane's direction has the same sign there.
+    near_row: [usize; 3],
+    /// Per axis, the smallest and largest origin and reciprocal direction over the active
+    /// lanes: the interval test of all children at once (only with shared signs).
+    o_lo: [f32; 3],
+    o_hi: [f32; 3],
+    i_lo: [f32; 3],
+    i_hi: [f32; 3],
+    lanes: Lanes16,
+}
+
+/// Lane `l`'s j-th permuted axis.
+#[inline(always)]
+fn axis(kmask: &[[u32; 2]; 3], j: usize, l: usize) -> usize {
+    if kmask[j][0] >> l & 1 != 0 {
+        0
+    } else if kmask[j][1] >> l & 1 != 0 {
+        1
+    } else {
+        2
+    }
+}
+
+/// Lane arrays of the set-up, for the single-ray tail.
+struct Lanes16 {
     inv: [[f32; WIDTH]; 3],
     shear: [[f32; WIDTH]; 3],
-    /// `kmask[j][c]`: lanes whose j-th permuted axis (kx, ky, kz) is c (c = 0, 1; else 2).
-    kmask: [[Mask; 2]; 3],
-    wr: [WatertightRay; WIDTH],
-    rays: [Ray; WIDTH],
 }
 
-impl Prep {
-    fn new(p: &RayPacket) -> Self {
-        let mut prep = Prep {
-            o: [p.ox, p.oy, p.oz],
-            inv: [p.dx.map(safe_inv), p.dy.map(safe_inv), p.dz.map(safe_inv)],
-            shear: [[0.0; WIDTH]; 3],
-            kmask: [[0; 2]; 3],
-            wr: [WatertightRay::new(glam::Vec3::Z); WIDTH],
-            rays: [Ray::new(glam::Vec3::ZERO, glam::Vec3::Z, 0.0); WIDTH],
+/// Which shared quantities a packet has (the kernel variant).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Shape {
+    /// Shared origin and direction signs.
+    Origin,
+    /// Shared direction signs.
+    Signs,
+    General,
+}
+
+impl<V: Vector<WIDTH>> Prep<V> {
+    #[inline(always)]
+    fn new(p: &RayPacket, active: LaneMask) -> (Self, Shape) {
+        let active = active as u32;
+        let d = [V::load(&p.dx), V::load(&p.dy), V::load(&p.dz)];
+        let (one, zero) = (V::splat(1.0), V::splat(0.0));
+        // safe_inv across lanes.
+        let tiny = V::splat(1e-30);
+        let big = 1.0f32 / 1e-30;
+        let (pos_big, neg_big) = (V::splat(big), V::splat(-big));
+        let mut inv = [zero; 3];
+        let mut inv_a = [[0.0; WIDTH]; 3];
+        for a in 0..3 {
+            let small = d[a].abs().lt(tiny);
+            let huge = V::select(d[a].sign(), neg_big, pos_big);
+            inv[a] = V::select(small, huge, one.div(d[a]));
+            inv[a].store(&mut inv_a[a]);
+        }
+        // WatertightRay::new across lanes: kz = the dominant axis, (kx, ky) the next two,
+        // swapped for a negative d[kz].
+        let ab = [d[0].abs(), d[1].abs(), d[2].abs()];
+        let m0 = ab[1].lt(ab[0]) & ab[2].lt(ab[0]);
+        let m1 = !ab[1].lt(ab[0]) & ab[2].lt(ab[1]) & FULL;
+        let m2 = !(m0 | m1) & FULL;
+        let dkz = V::select(m0, d[0], V::select(m1, d[1], d[2]));
+        let neg = dkz.lt(zero);
+        let pos = !neg & FULL;
+        let kx = [(m2 & pos) | (m1 & neg), (m0 & pos) | (m2 & neg)];
+        let ky = [(m1 & pos) | (m2 & neg), (m2 & pos) | (m0 & neg)];
+        let dkx = V::select(kx[0], d[0], V::select(kx[1], d[1], d[2]));
+        let dky = V::select(ky[0], d[0], V::select(ky[1], d[1], d[2]));
+        let shear = [dkx.div(dkz), dky.div(dkz), one.div(dkz)];
+        let mut shear_a = [[0.0; WIDTH]; 3];
+        for j in 0..3 {
+            shear[j].store(&mut shear_a[j]);
+        }
+        let kmask = [kx, ky, [m0, m1]];
+        let same = |m: u32| m & active == active || m & active == 0;
+        let uniform = (same(m0) && same(m1) && same(m2) && same(neg)).then(|| {
+            let l = active.trailing_zeros() as usize;
+            [axis(&kmask, 0, l), axis(&kmask, 1, l), axis(&kmask, 2, l)]
+        });
+        let first = active.trailing_zeros() as usize;
+        let origin = [p.ox[first], p.oy[first], p.oz[first]];
+        let o = [V::load(&p.ox), V::load(&p.oy), V::load(&p.oz)];
+        let (inf, ninf) = (V::splat(f32::INFINITY), V::splat(f32::NEG_INFINITY));
+        let (mut o_lo, mut o_hi, mut i_lo, mut i_hi) = ([0.0; 3], [0.0; 3], [0.0; 3], [0.0; 3]);
+        let mut shared = true;
+        let mut near_row = [0; 3];
+        let mut signs = true;
+        for a in 0..3 {
+            // Bit-for-bit equal: equal as floats with equal sign bits.
+            let o0 = V::splat(origin[a]);
+            let same = o[a].eq(o0) & !(o[a].sign() ^ o0.sign());
+            shared &= same & active == active;
+            o_lo[a] = V::select(active, o[a], inf).reduce_min();
+            o_hi[a] = V::select(active, o[a], ninf).reduce_max();
+            i_lo[a] = V::select(active, inv[a], inf).reduce_min();
+            i_hi[a] = V::select(active, inv[a], ninf).reduce_max();
+            let s = inv[a].sign() & active;
+            signs &= s == 0 || s == active;
+            near_row[a] = if s != 0 { a + MAX_ROW } else { a };
+        }
+        let shape = match (shared, signs) {
+            (true, true) => Shape::Origin,
+            (_, true) => Shape::Signs,
+            _ => Shape::General,
         };
-        for l in 0..WIDTH {
-            let ray = p.get(l);
-            // Inactive lanes may hold a zero direction; their constants are never used.
-            let wr = if ray.dir == glam::Vec3::ZERO {
-                WatertightRay::new(glam::Vec3::Z)
-            } else {
-                WatertightRay::new(ray.dir)
-            };
-            let (k, s) = (wr.axes(), wr.shear());
-            for j in 0..3 {
-                prep.shear[j][l] = s[j];
-                for c in 0..2 {
-                    if k[j] == c {
-                        prep.kmask[j][c] |= 1 << l;
-                    }
+        (
+            Prep {
+                o,
+                inv,
+                shear,
+                kmask,
+                uniform,
+                origin,
+                neg,
+                near_row,
+                o_lo,
+                o_hi,
+                i_lo,
+                i_hi,
+                lanes: Lanes16 {
+                    inv: inv_a,
+                    shear: shear_a,
+                },
+            },
+            shape,
+        )
+    }
+
+    /// Lane `l` as a single ray, from the packet's set-up (no recomputation).
+    #[inline(always)]
+    fn ray1(&self, p: &RayPacket, l: usize) -> Ray1 {
+        // kz from the dominant-axis masks, (kx, ky) from kz and the sign (as WatertightRay).
+        const XY: [[[usize; 2]; 2]; 3] = [[[1, 2], [2, 1]], [[2, 0], [0, 2]], [[0, 1], [1, 0]]];
+        let (b0, b1) = ((self.kmask[2][0] >> l) & 1, (self.kmask[2][1] >> l) & 1);
+        let kz = (2 - 2 * b0 - b1) as usize;
+        let [kx, ky] = XY[kz][((self.neg >> l) & 1) as usize];
+        let k = [kx, ky, kz];
+        let s = [
+            self.lanes.shear[0][l],
+            self.lanes.shear[1][l],
+            self.lanes.shear[2][l],
+        ];
+        let inv = [
+            self.lanes.inv[0][l],
+            self.lanes.inv[1][l],
+            self.lanes.inv[2][l],
+        ];
+        Ray1::from_parts(p.get(l), inv, k, s)
+    }
+
+    /// Per lane, component `k[j]` of (x, y, z).
+    #[inline(always)]
+    fn pick(&self, j: usize, v: &[V; 3]) -> V {
+        let m = &self.kmask[j];
+        V::select(m[0], v[0], V::select(m[1], v[1], v[2]))
+    }
+
+    /// Triangle `slot` of a block in every lane's sheared space.
+    #[inline(always)]
+    fn sheared<const ORIGIN: bool>(&self, blk: &Block, slot: usize) -> Sheared<V> {
+        let z = V::splat(0.0);
+        let mut s = Sheared {
+            x: [z; 3],
+            y: [z; 3],
+            z: [z; 3],
+        };
+        for vtx in 0..3 {
+            let v = &blk.v[vtx];
+            let (px, py, pz) = match self.uniform {
+                // The permutation picks rows of the block: no per-lane shuffles.
+                Some(k) => (
+                    self.rel::<ORIGIN>(v, k[0], slot),
+                    self.rel::<ORIGIN>(v, k[1], slot),
+                    self.rel::<ORIGIN>(v, k[2], slot),
+                ),
+                None => {
+                    let p = [
+                        self.rel::<ORIGIN>(v, 0, slot),
+                        self.rel::<ORIGIN>(v, 1, slot),
+                        self.rel::<ORIGIN>(v, 2, slot),
+                    ];
+                    (self.pick(0, &p), self.pick(1, &p), self.pick(2, &p))
                 }
+            };
+            s.x[vtx] = px.sub(self.shear[0].mul(pz));
+            s.y[vtx] = py.sub(self.shear[1].mul(pz));
+            s.z[vtx] = self.shear[2].mul(pz);
+        }
+        s
+    }
+
+    /// Coordinate `a` of a block vertex relative to every lane's origin.
+    #[inline(always)]
+    fn rel<const ORIGIN: bool>(&self, v: &[[f32; NARROW]; 3], a: usize, slot: usize) -> V {
+        if ORIGIN {
+            V::splat(v[a][slot] - self.origin[a])
+        } else {
+            V::splat(v[a][slot]).sub(self.o_axis(a))
+        }
+    }
+
+    /// The origin vector of axis `a` (a runtime index: selected, not indexed, so the vectors
+    /// stay in registers).
+    #[inline(always)]
+    fn o_axis(&self, a: usize) -> V {
+        match a {
+            0 => self.o[0],
+            1 => self.o[1],
+            _ => self.o[2],
+        }
+    }
+
+    /// Lanes whose ray meets child `i`'s box within (0, cull); entry distances in `near_out`.
+    #[inline(always)]
+    fn slab<const ORIGIN: bool, const SIGNS: bool>(
+        &self,
+        n: &Node,
+        i: usize,
+        cull: V,
+        near_out: &mut [f32; WIDTH],
+    ) -> u32 {
+        let mut near = V::splat(0.0);
+        let mut far = V::splat(f32::INFINITY);
+        for a in 0..3 {
+            let (lo, hi) = if SIGNS {
+                let lo = self.near_row[a];
+                (
+                    lo,
+                    if lo < MAX_ROW {
+                        lo + MAX_ROW
+                    } else {
+                        lo - MAX_ROW
+                    },
+                )
+            } else {
+                (a, a + MAX_ROW)
+            };
+            let (b0, b1) = if ORIGIN {
+                (
+                    V::splat(n.b[lo][i] - self.origin[a]),
+                    V::splat(n.b[hi][i] - self.origin[a]),
+                )
+            } else {
+                (
+                    V::splat(n.b[lo][i]).sub(self.o[a]),
+                    V::splat(n.b[hi][i]).sub(self.o[a]),
+                )
+            };
+            let (t0, t1) = (b0.mul(self.inv[a]), b1.mul(self.inv[a]));
+            if SIGNS {
+                near = t0.max(near);
+                far = t1.min(far);
+            } else {
+                near = t0.min(t1).max(near);
+                far = t0.max(t1).min(far);
             }
-            prep.wr[l] = wr;
-            prep.rays[l] = ray;
         }
-        prep
+        let far = far.mul(V::splat(FAR_SCALE)).min(cull);
+        near.store(near_out);
+        near.le(far)
     }
-}
 
-/// Lanes whose ray meets the node's box within (0, tmax).
-#[inline(always)]
-fn slab<L: Lanes>(o: &[L::V; 3], inv: &[L::V; 3], n: &Node, tmax: L::V) -> Mask {
-    let mut near = L::splat(0.0);
-    let mut far = L::splat(f32::INFINITY);
-    for a in 0..3 {
-        let t0 = L::mul(L::sub(L::splat(n.min[a]), o[a]), inv[a]);
-        let t1 = L::mul(L::sub(L::splat(n.max[a]), o[a]), inv[a]);
-        near = L::max(L::min(t0, t1), near);
-        far = L::min(L::max(t0, t1), far);
+    /// Children that some lane may hit: the slab test of all 8 children at once (one 8-lane
+    /// sequence) on the interval hull of the lanes' origins and reciprocal directions, with
+    /// the largest cull distance of the lanes. Rounding is monotone, so the hull's extreme
+    /// products bound every lane's computed distances: a child rejected here is rejected by
+    /// each lane's own test (Wald et al. 2007's interval culling, exact in floating point).
+    #[inline(always)]
+    fn interval<W: Vector<NARROW>, const ORIGIN: bool>(&self, n: &Node, cull_max: f32) -> u32 {
+        let lo = [W::load(&n.b[0]), W::load(&n.b[1]), W::load(&n.b[2])];
+        let hi = [W::load(&n.b[3]), W::load(&n.b[4]), W::load(&n.b[5])];
+        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0, cull_max)
     }
-    let far = L::min(tmax, L::mul(far, L::splat(FAR_SCALE)));
-    L::le(near, far)
-}
 
-/// Picks, per lane, component `k` of (x, y, z) by the lane's permutation masks.
-#[inline(always)]
-fn pick<L: Lanes>(m: &[Mask; 2], v: &[L::V; 3]) -> L::V {
-    L::select(m[0], v[0], L::select(m[1], v[1], v[2]))
-}
-
-/// Watertight triangle test on the lanes in `m`, against per-lane `tmax`. Hit lanes get
-/// (t, b1, b2) in `out`. Operations mirror `Triangle::intersect` one for one (no FMA), so
-/// t and barycentrics are bit-identical; lanes with an exactly-zero edge function take the
-/// scalar path, which redoes them in f64.
-#[inline(always)]
-fn triangle<L: Lanes>(
-    tri: &Triangle,
-    prep: &Prep,
-    o: &[L::V; 3],
-    shear: &[L::V; 3],
-    tmax: &[f32; WIDTH],
-    m: Mask,
-    out: &mut [[f32; WIDTH]; 3],
-) -> Mask {
-    let rel = |p: glam::Vec3| -> [L::V; 3] {
-        [
-            L::sub(L::splat(p.x), o[0]),
-            L::sub(L::splat(p.y), o[1]),
-            L::sub(L::splat(p.z), o[2]),
-        ]
-    };
-    let (a, b, c) = (rel(tri.v0), rel(tri.v1), rel(tri.v2));
-    let km = &prep.kmask;
-    let (akz, bkz, ckz) = (
-        pick::<L>(&km[2], &a),
-        pick::<L>(&km[2], &b),
-        pick::<L>(&km[2], &c),
-    );
-    let ax = L::sub(pick::<L>(&km[0], &a), L::mul(shear[0], akz));
-    let ay = L::sub(pick::<L>(&km[1], &a), L::mul(shear[1], akz));
-    let bx = L::sub(pick::<L>(&km[0], &b), L::mul(shear[0], bkz));
-    let by = L::sub(pick::<L>(&km[1], &b), L::mul(shear[1], bkz));
-    let cx = L::sub(pick::<L>(&km[0], &c), L::mul(shear[0], ckz));
-    let cy = L::sub(pick::<L>(&km[1], &c), L::mul(shear[1], ckz));
-    let u = L::sub(L::mul(cx, by), L::mul(cy, bx));
-    let v = L::sub(L::mul(ax, cy), L::mul(ay, cx));
-    let w = L::sub(L::mul(bx, ay), L::mul(by, ax));
-    let zero = L::splat(0.0);
-    let edge0 = (L::eq(u, zero) | L::eq(v, zero) | L::eq(w, zero)) & m;
-    let neg = L::lt(u, zero) | L::lt(v, zero) | L::lt(w, zero);
-    let pos = L::lt(zero, u) | L::lt(zero, v) | L::lt(zero, w);
-    let mut hit = m & !edge0 & !(neg & pos);
-    let mut unsure: Mask = 0;
-    let det = L::add(L::add(u, v), w);
-    hit &= !L::eq(det, zero);
-    if hit != 0 {
-        let az = L::mul(shear[2], akz);
-        let bz = L::mul(shear[2], bkz);
-        let cz = L::mul(shear[2], ckz);
-        let ts = L::add(L::add(L::mul(u, az), L::mul(v, bz)), L::mul(w, cz));
-        // ts · sign(det): exact, since sign(det) = ±1.
-        let tss = L::select(L::lt(det, zero), L::sub(zero, ts), ts);
-        let tm = L::load(tmax);
-        hit &= L::lt(zero, tss) & L::lt(tss, L::mul(tm, L::abs(det)));
-        // t within the test's error bound (pbrt-v4 §6.8.7): see `conservative_t_bound`, same
-        // expression, same order as the scalar test, and skipped, as there, for triangles
-        // wholly ahead of the origin along the dominant axis.
-        let ahead = L::lt(zero, az) & L::lt(zero, bz) & L::lt(zero, cz);
-        let check = hit & !ahead;
-        if check != 0 {
-            let amax = |p: L::V, q: L::V, r: L::V| L::max(L::max(L::abs(p), L::abs(q)), L::abs(r));
-            let (max_xt, max_yt) = (amax(ax, bx, cx), amax(ay, by, cy));
-            let (max_zt, max_e) = (amax(az, bz, cz), amax(u, v, w));
-            let g = |n: u32| L::splat(crate::math::gamma(n));
-            let delta_x = L::mul(g(5), L::add(max_xt, max_zt));
-            let delta_y = L::mul(g(5), L::add(max_yt, max_zt));
-            let delta_z = L::mul(g(3), max_zt);
-            let delta_e = L::mul(
-                L::splat(2.0),
-                L::add(
-                    L::add(
-                        L::mul(L::mul(g(2), max_xt), max_yt),
-                        L::mul(delta_y, max_xt),
-                    ),
-                    L::mul(delta_x, max_yt),
-                ),
+    /// Triangles of a block that some lane may hit: [`Self::interval`] on the triangles'
+    /// boxes, widened by 2⁻¹⁶ of the distances, far beyond the rounding by which the
+    /// watertight test can accept a ray passing just outside a triangle's box.
+    #[inline(always)]
+    fn interval_tris<W: Vector<NARROW>, const ORIGIN: bool>(
+        &self,
+        blk: &Block,
+        cull_max: f32,
+    ) -> u32 {
+        let z = W::splat(0.0);
+        let (mut lo, mut hi) = ([z; 3], [z; 3]);
+        for a in 0..3 {
+            let (p, q, r) = (
+                W::load(&blk.v[0][a]),
+                W::load(&blk.v[1][a]),
+                W::load(&blk.v[2][a]),
             );
-            let bound = L::mul(
-                L::splat(3.0),
-                L::add(
-                    L::add(L::mul(L::mul(g(3), max_e), max_zt), L::mul(delta_e, max_zt)),
-                    L::mul(delta_z, max_e),
-                ),
-            );
-            // Lanes inside the bound take the scalar path, which settles them in f64.
-            let ambiguous = check & !L::lt(bound, tss);
-            hit &= !ambiguous;
-            unsure |= ambiguous;
+            lo[a] = p.min(q).min(r);
+            hi[a] = p.max(q).max(r);
         }
-        if hit != 0 {
-            let inv = L::div(L::splat(1.0), det);
-            let t = L::mul(ts, inv);
-            hit &= L::lt(t, tm);
-            L::store(t, &mut out[0]);
-            L::store(L::mul(v, inv), &mut out[1]);
-            L::store(L::mul(w, inv), &mut out[2]);
+        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0 + 1.0 / 65536.0, cull_max)
+    }
+
+    /// The interval slab test of 8 boxes; `widen` ≥ 1 scales the far distances up and the
+    /// near ones down.
+    #[inline(always)]
+    fn interval_boxes<W: Vector<NARROW>, const ORIGIN: bool>(
+        &self,
+        lo: &[W; 3],
+        hi: &[W; 3],
+        widen: f32,
+        cull_max: f32,
+    ) -> u32 {
+        let mut near = W::splat(0.0);
+        let mut far = W::splat(f32::INFINITY);
+        for a in 0..3 {
+            let (bn, bf) = if self.near_row[a] < MAX_ROW {
+                (lo[a], hi[a])
+            } else {
+                (hi[a], lo[a])
+            };
+            let (il, ih) = (W::splat(self.i_lo[a]), W::splat(self.i_hi[a]));
+            if ORIGIN {
+                let o = W::splat(self.origin[a]);
+                let (dn, df) = (bn.sub(o), bf.sub(o));
+                near = dn.mul(il).min(dn.mul(ih)).max(near);
+                far = df.mul(il).max(df.mul(ih)).min(far);
+            } else {
+                let (ol, oh) = (W::splat(self.o_lo[a]), W::splat(self.o_hi[a]));
+                let (n0, n1) = (bn.sub(oh), bn.sub(ol));
+                let (f0, f1) = (bf.sub(oh), bf.sub(ol));
+                let nmin = n0.mul(il).min(n0.mul(ih)).min(n1.mul(il).min(n1.mul(ih)));
+                let fmax = f0.mul(il).max(f0.mul(ih)).max(f1.mul(il).max(f1.mul(ih)));
+                near = nmin.max(near);
+                far = fmax.min(far);
+            }
+        }
+        let (near, far) = if widen > 1.0 {
+            (
+                near.div(W::splat(widen)),
+                far.mul(W::splat(FAR_SCALE * widen)),
+            )
+        } else {
+            (near, far.mul(W::splat(FAR_SCALE)))
+        };
+        near.le(far.min(W::splat(cull_max)))
+    }
+
+    /// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
+    /// entry distance of each child's first lane.
+    #[inline(always)]
+    fn push_children<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+        &self,
+        n: &Node,
+        m: u32,
+        cull: V,
+        stack: &mut Stack,
+    ) {
+        let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask, 0.0f32); 8];
+        let mut k = 0;
+        let mut near = [0.0; WIDTH];
+        let inf = V::splat(f32::INFINITY);
+        let mut cand = if SIGNS {
+            let cull_max = V::select(m, cull, V::splat(f32::NEG_INFINITY)).reduce_max();
+            self.interval::<W, ORIGIN>(n, cull_max)
+        } else {
+            (1 << n.count) - 1
+        };
+        while cand != 0 {
+            let i = cand.trailing_zeros() as usize;
+            cand &= cand - 1;
+            let hit = m & self.slab::<ORIGIN, SIGNS>(n, i, cull, &mut near);
+            if hit != 0 {
+                // The smallest entry distance of the child's lanes: lanes whose closest hit
+                // is nearer by the time it is popped skip it.
+                let entry = V::select(hit, V::load(&near), inf).reduce_min();
+                let key = near[hit.trailing_zeros() as usize];
+                let key = if FAULT & FAULT_FAR_FIRST != 0 {
+                    -key
+                } else {
+                    key
+                };
+                // Insertion by descending key: the nearest ends on top of the stack.
+                let mut j = k;
+                while j > 0 && keys[j - 1].0 < key {
+                    keys[j] = keys[j - 1];
+                    j -= 1;
+                }
+                keys[j] = (key, n.child[i], hit as Mask, entry);
+                k += 1;
+            }
+        }
+        for &(_, c, hm, entry) in &keys[..k] {
+            stack.push(c, hm, entry);
         }
     }
-    let mut rest = edge0 | unsure;
-    while rest != 0 {
-        let l = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        let r = Ray::new(prep.rays[l].origin, prep.rays[l].dir, tmax[l]);
-        if let Some(h) = tri.intersect(&r, &prep.wr[l])
-            && h.t < tmax[l]
-        {
-            out[0][l] = h.t;
-            out[1][l] = h.b1;
-            out[2][l] = h.b2;
-            hit |= 1 << l;
-        }
-    }
-    hit
 }
 
-/// Child visit order from the first active lane's direction along the axis that best
-/// separates the two child boxes (cheap front-to-back for coherent packets).
-#[inline(always)]
-fn near_first(tr: &PacketTracer, n: &Node, prep: &Prep, m: Mask) -> (u32, u32) {
-    let (a, b) = (&tr.nodes[n.first as usize], &tr.nodes[n.first as usize + 1]);
-    let mut axis = 0;
-    let mut best = -1.0f32;
-    for k in 0..3 {
-        let d = ((b.min[k] + b.max[k]) - (a.min[k] + a.max[k])).abs();
-        if d > best {
-            best = d;
-            axis = k;
-        }
+/// A (child, lane mask, smallest entry distance) stack without initialising its storage.
+struct Stack {
+    e: [MaybeUninit<(Child, Mask, f32)>; STACK],
+    sp: usize,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new(root: Child, active: LaneMask) -> Self {
+        let mut s = Stack {
+            e: [const { MaybeUninit::uninit() }; STACK],
+            sp: 0,
+        };
+        s.push(root, active, 0.0);
+        s
     }
-    let lane = m.trailing_zeros() as usize;
-    let d = prep.inv[axis][lane];
-    let a_lower = a.min[axis] + a.max[axis] <= b.min[axis] + b.max[axis];
-    if (d >= 0.0) == a_lower {
-        (n.first, n.first + 1)
-    } else {
-        (n.first + 1, n.first)
+    #[inline(always)]
+    fn push(&mut self, c: Child, m: Mask, entry: f32) {
+        // The build bounds depth · BRANCH by STACK; indexing checks anyway.
+        self.e[self.sp] = MaybeUninit::new((c, m, entry));
+        self.sp += 1;
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(Child, u32, f32)> {
+        if self.sp == 0 {
+            return None;
+        }
+        self.sp -= 1;
+        // SAFETY: entries below sp were written by push.
+        let (c, m, t) = unsafe { self.e[self.sp].assume_init() };
+        Some((c, m as u32, t))
     }
 }
 
-pub struct Closest<'a> {
+/// Closest hits so far, per lane.
+struct Bests {
+    t: [f32; WIDTH],
+    u: [f32; WIDTH],
+    v: [f32; WIDTH],
+    prim: [u32; WIDTH],
+    tmax: [f32; WIDTH],
+}
+
+impl Bests {
+    #[inline(always)]
+    fn get(&self, l: usize) -> Best {
+        Best {
+            t: self.t[l],
+            prim: self.prim[l],
+            u: self.u[l],
+            v: self.v[l],
+            tmax: self.tmax[l],
+        }
+    }
+
+    #[inline(always)]
+    fn put(&mut self, l: usize, b: &Best) {
+        (self.t[l], self.prim[l], self.u[l], self.v[l]) = (b.t, b.prim, b.u, b.v);
+    }
+
+    /// [`Best::offer`] for the hit lanes of one triangle (their t is below the tmax they
+    /// were tested with, which is at most the ray's).
+    #[inline(always)]
+    fn offer<V: Vector<WIDTH>>(&mut self, hit: u32, out: &Out<WIDTH>, prim: u32) {
+        let t = V::load(&out[0]);
+        let bt = V::load(&self.t);
+        let mut take = hit & t.lt(bt);
+        let mut tie = hit & t.eq(bt);
+        while tie != 0 {
+            let l = tie.trailing_zeros() as usize;
+            tie &= tie - 1;
+            if prim < self.prim[l] {
+                take |= 1 << l;
+            }
+        }
+        if take == 0 {
+            return;
+        }
+        V::select(take, t, bt).store(&mut self.t);
+        V::select(take, V::load(&out[1]), V::load(&self.u)).store(&mut self.u);
+        V::select(take, V::load(&out[2]), V::load(&self.v)).store(&mut self.v);
+        while take != 0 {
+            let l = take.trailing_zeros() as usize;
+            take &= take - 1;
+            self.prim[l] = prim;
+        }
+    }
+
+    /// Per lane `min(tmax, best · CULL_SCALE)`: see [`Best::test_tmax`].
+    #[inline(always)]
+    fn test_tmax<V: Vector<WIDTH>>(&self) -> V {
+        V::load(&self.t)
+            .mul(V::splat(CULL_SCALE))
+            .min(V::load(&self.tmax))
+    }
+}
+
+pub struct Closest<'a, const FAULT: u32> {
     pub tr: &'a PacketTracer,
     pub rays: &'a RayPacket,
     pub active: LaneMask,
@@ -222,204 +532,260 @@ pub struct Closest<'a> {
     pub stats: &'a mut TraceStats,
 }
 
-impl Kernel for Closest<'_> {
+impl<const FAULT: u32> Kernel for Closest<'_, FAULT> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
-        let Closest {
-            tr,
-            rays,
-            active,
-            hits,
-            stats,
-        } = self;
-        let prep = Prep::new(rays);
-        let o = prep.o.map(|x| L::load(&x));
-        let inv = prep.inv.map(|x| L::load(&x));
-        let shear = prep.shear.map(|x| L::load(&x));
-        let mut best_t = rays.tmax;
-        let mut tv = L::load(&best_t);
-        let mut out = [[0.0f32; WIDTH]; 3];
-        let mut stack = [(0u32, 0 as Mask); STACK];
-        stack[0] = (0, active);
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            let (ni, m_in) = stack[sp];
-            let n = tr.nodes[ni as usize];
-            stats.packet_nodes += 1;
-            stats.packet_lanes += m_in.count_ones() as u64;
-            let m = m_in & slab::<L>(&o, &inv, &n, tv);
-            if m == 0 {
-                continue;
+        let (p, shape) = Prep::<L::V>::new(self.rays, self.active);
+        let mut best = Bests {
+            t: self.rays.tmax,
+            u: [0.0; WIDTH],
+            v: [0.0; WIDTH],
+            prim: [NO_HIT; WIDTH],
+            tmax: self.rays.tmax,
+        };
+        let (tr, rays, active, stats) = (self.tr, self.rays, self.active, self.stats);
+        match shape {
+            Shape::Origin => {
+                closest::<L, FAULT, true, true>(tr, &p, rays, active, &mut best, stats)
             }
-            if m.count_ones() < HYBRID_LANES {
+            Shape::Signs => {
+                closest::<L, FAULT, false, true>(tr, &p, rays, active, &mut best, stats)
+            }
+            Shape::General => {
+                closest::<L, FAULT, false, false>(tr, &p, rays, active, &mut best, stats)
+            }
+        }
+        let hits = self.hits;
+        for l in 0..WIDTH {
+            if best.prim[l] != NO_HIT {
+                hits.t[l] = best.t[l];
+                hits.prim[l] = best.prim[l];
+                hits.u[l] = best.u[l];
+                hits.v[l] = best.v[l];
+            }
+        }
+    }
+}
+
+#[inline(always)]
+fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    tr: &PacketTracer,
+    p: &Prep<L::V>,
+    rays: &RayPacket,
+    active: LaneMask,
+    best: &mut Bests,
+    stats: &mut TraceStats,
+) {
+    let g = &*tr.geometry;
+    let mut stack = Stack::new(tr.wide.root, active);
+    let mut out = [[0.0f32; WIDTH]; 3];
+    while let Some((c, m, entry)) = stack.pop() {
+        // Drop the lanes whose closest hit now lies before the child (as their slab test
+        // would: conservative, since entry is the smallest of the lanes' entry distances).
+        let passed = L::V::load(&best.t)
+            .mul(L::V::splat(CULL_SCALE))
+            .lt(L::V::splat(entry));
+        let m = m & !passed;
+        if m == 0 {
+            continue;
+        }
+        if m.count_ones()
+            < if c.is_inner() {
+                tr.hybrid.0
+            } else {
+                tr.hybrid.1
+            }
+        {
+            let mut rest = m;
+            while rest != 0 {
+                let l = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let mut b = best.get(l);
+                let r = p.ray1(rays, l);
+                single::closest::<L, FAULT>(tr, &r, c, &mut b, stats, &mut |_| {});
+                best.put(l, &b);
+            }
+            continue;
+        }
+        match c.kind() {
+            Kind::Inner(i) => {
+                let n = &tr.wide.nodes[i as usize];
+                stats.packet_nodes += 1;
+                stats.packet_lanes += m.count_ones() as u64;
+                let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
+                p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+            }
+            Kind::Block(b, count) => {
+                stats.leaves += 1;
+                let blk = &tr.wide.blocks[b as usize];
+                let tm = best.test_tmax::<L::V>();
+                let mut cand = (1u32 << count) - 1;
+                if SIGNS {
+                    let cull_max = L::V::select(m, tm, L::V::splat(f32::NEG_INFINITY)).reduce_max();
+                    cand &= p.interval_tris::<L::W, ORIGIN>(blk, cull_max);
+                }
+                while cand != 0 {
+                    let slot = cand.trailing_zeros() as usize;
+                    cand &= cand - 1;
+                    let s = p.sheared::<ORIGIN>(blk, slot);
+                    let prim = blk.prim[slot];
+                    let (hit, mut rest) =
+                        leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
+                    if hit != 0 {
+                        best.offer::<L::V>(hit, &out, prim);
+                    }
+                    if rest != 0 {
+                        let mut tmv = [0.0; WIDTH];
+                        tm.store(&mut tmv);
+                        while rest != 0 {
+                            let l = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            let r = p.ray1(rays, l);
+                            let ray = Ray::new(r.ray.origin, r.ray.dir, tmv[l]);
+                            if let Some(h) = g.triangles[prim as usize].intersect(&ray, &r.wr) {
+                                let mut b = best.get(l);
+                                b.offer(h.t, prim, h.b1, h.b2);
+                                best.put(l, &b);
+                            }
+                        }
+                    }
+                }
+            }
+            Kind::Sphere(prim) => {
+                stats.leaves += 1;
+                let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
                 let mut rest = m;
                 while rest != 0 {
                     let l = rest.trailing_zeros() as usize;
                     rest &= rest - 1;
-                    let mut b = Best {
-                        t: best_t[l],
-                        prim: hits.prim[l],
-                        u: hits.u[l],
-                        v: hits.v[l],
-                    };
-                    single::closest(tr, &prep.rays[l], ni, &mut b, stats);
-                    (best_t[l], hits.prim[l], hits.u[l], hits.v[l]) = (b.t, b.prim, b.u, b.v);
-                }
-                tv = L::load(&best_t);
-                continue;
-            }
-            if n.count == 0 {
-                let (near, far) = near_first(tr, &n, &prep, m);
-                stack[sp] = (far, m);
-                stack[sp + 1] = (near, m);
-                sp += 2;
-                continue;
-            }
-            for slot in n.first..n.first + n.count {
-                let prim = tr.slot_prim[slot as usize];
-                let mut hit = match tr.geometry.sphere_index(prim) {
-                    None => triangle::<L>(
-                        &tr.geometry.triangles[prim as usize],
-                        &prep,
-                        &o,
-                        &shear,
-                        &best_t,
-                        m,
-                        &mut out,
-                    ),
-                    Some(_) => sphere_lanes(tr, &prep, prim, &best_t, m, &mut out),
-                };
-                while hit != 0 {
-                    let l = hit.trailing_zeros() as usize;
-                    hit &= hit - 1;
-                    (best_t[l], hits.prim[l], hits.u[l], hits.v[l]) =
-                        (out[0][l], prim, out[1][l], out[2][l]);
+                    let mut b = best.get(l);
+                    let r = rays.get(l);
+                    if let Some(t) = sphere.intersect(&Ray::new(r.origin, r.dir, b.test_tmax())) {
+                        b.offer(t, prim, 0.0, 0.0);
+                        best.put(l, &b);
+                    }
                 }
             }
-            tv = L::load(&best_t);
-        }
-        for ((t, &p), &b) in hits.t.iter_mut().zip(&hits.prim).zip(&best_t) {
-            *t = if p == crate::tracer::NO_HIT {
-                f32::INFINITY
-            } else {
-                b
-            };
+            Kind::Empty => {}
         }
     }
 }
 
-/// Spheres are few (lights, analytic shapes): tested per lane with the scalar routine.
-#[inline(always)]
-fn sphere_lanes(
-    tr: &PacketTracer,
-    prep: &Prep,
-    prim: u32,
-    tmax: &[f32; WIDTH],
-    m: Mask,
-    out: &mut [[f32; WIDTH]; 3],
-) -> Mask {
-    let mut hit = 0;
-    let mut rest = m;
-    while rest != 0 {
-        let l = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        let r = Ray::new(prep.rays[l].origin, prep.rays[l].dir, tmax[l]);
-        if let Some((t, u, v)) = prim_hit(tr, &r, &prep.wr[l], prim)
-            && t < tmax[l]
-        {
-            (out[0][l], out[1][l], out[2][l]) = (t, u, v);
-            hit |= 1 << l;
-        }
-    }
-    hit
-}
-
-pub struct Occluded<'a> {
+pub struct Occluded<'a, const FAULT: u32> {
     pub tr: &'a PacketTracer,
     pub rays: &'a RayPacket,
     pub active: LaneMask,
     pub stats: &'a mut TraceStats,
 }
 
-impl Kernel for Occluded<'_> {
+impl<const FAULT: u32> Kernel for Occluded<'_, FAULT> {
     type Out = LaneMask;
     #[inline(always)]
     fn run<L: Lanes>(self) -> LaneMask {
-        let Occluded {
-            tr,
-            rays,
-            active,
-            stats,
-        } = self;
-        let prep = Prep::new(rays);
-        let o = prep.o.map(|x| L::load(&x));
-        let inv = prep.inv.map(|x| L::load(&x));
-        let shear = prep.shear.map(|x| L::load(&x));
-        let tmax = rays.tmax;
-        let tv = L::load(&tmax);
-        let mut out = [[0.0f32; WIDTH]; 3];
-        // Lanes still looking for an occluder; a lane retires at its first hit.
-        let mut alive = active;
-        let mut stack = [(0u32, 0 as Mask); STACK];
-        stack[0] = (0, active);
-        let mut sp = 1;
-        while sp > 0 && alive != 0 {
-            sp -= 1;
-            let (ni, m_in) = stack[sp];
-            let m_in = m_in & alive;
-            if m_in == 0 {
-                continue;
+        let (p, shape) = Prep::<L::V>::new(self.rays, self.active);
+        let (tr, rays, active, stats) = (self.tr, self.rays, self.active, self.stats);
+        match shape {
+            Shape::Origin => occluded::<L, FAULT, true, true>(tr, &p, rays, active, stats),
+            Shape::Signs => occluded::<L, FAULT, false, true>(tr, &p, rays, active, stats),
+            Shape::General => occluded::<L, FAULT, false, false>(tr, &p, rays, active, stats),
+        }
+    }
+}
+
+#[inline(always)]
+fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    tr: &PacketTracer,
+    p: &Prep<L::V>,
+    rays: &RayPacket,
+    active: LaneMask,
+    stats: &mut TraceStats,
+) -> LaneMask {
+    let g = &*tr.geometry;
+    let tm = L::V::load(&rays.tmax);
+    let cull = tm.mul(L::V::splat(CULL_SCALE));
+    let mut out = [[0.0f32; WIDTH]; 3];
+    // Lanes still looking for an occluder; a lane retires at its first hit.
+    let mut alive = active as u32;
+    let mut stack = Stack::new(tr.wide.root, active);
+    while let Some((c, m, _)) = stack.pop() {
+        let mut m = m & alive;
+        if m == 0 {
+            continue;
+        }
+        if m.count_ones()
+            < if c.is_inner() {
+                tr.hybrid.0
+            } else {
+                tr.hybrid.1
             }
-            let n = tr.nodes[ni as usize];
-            stats.packet_nodes += 1;
-            stats.packet_lanes += m_in.count_ones() as u64;
-            let m = m_in & slab::<L>(&o, &inv, &n, tv);
-            if m == 0 {
-                continue;
+        {
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if single::occluded::<L, FAULT>(tr, &p.ray1(rays, l), c, stats) {
+                    alive &= !(1 << l);
+                }
             }
-            if m.count_ones() < HYBRID_LANES {
-                let mut rest = m;
-                while rest != 0 {
-                    let l = rest.trailing_zeros() as usize;
-                    rest &= rest - 1;
-                    if single::occluded(tr, &prep.rays[l], ni, stats) {
-                        alive &= !(1 << l);
+        } else {
+            match c.kind() {
+                Kind::Inner(i) => {
+                    let n = &tr.wide.nodes[i as usize];
+                    stats.packet_nodes += 1;
+                    stats.packet_lanes += m.count_ones() as u64;
+                    p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+                }
+                Kind::Block(b, count) => {
+                    stats.leaves += 1;
+                    let blk = &tr.wide.blocks[b as usize];
+                    let mut cand = (1u32 << count) - 1;
+                    if SIGNS {
+                        let cull_max =
+                            L::V::select(m, tm, L::V::splat(f32::NEG_INFINITY)).reduce_max();
+                        cand &= p.interval_tris::<L::W, ORIGIN>(blk, cull_max);
+                    }
+                    while cand != 0 {
+                        let slot = cand.trailing_zeros() as usize;
+                        cand &= cand - 1;
+                        let s = p.sheared::<ORIGIN>(blk, slot);
+                        let prim = blk.prim[slot];
+                        let (mut occ, mut rest) =
+                            leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
+                        while rest != 0 {
+                            let l = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            let r = p.ray1(rays, l);
+                            if g.triangles[prim as usize]
+                                .intersect(&r.ray, &r.wr)
+                                .is_some_and(|h| h.t < r.ray.tmax)
+                            {
+                                occ |= 1 << l;
+                            }
+                        }
+                        m &= !occ;
+                        alive &= !occ;
+                        if m == 0 {
+                            break;
+                        }
                     }
                 }
-                continue;
-            }
-            if n.count == 0 {
-                // Any-hit needs no exact order; still near-first, as it finds occluders sooner.
-                let (near, far) = near_first(tr, &n, &prep, m);
-                stack[sp] = (far, m);
-                stack[sp + 1] = (near, m);
-                sp += 2;
-                continue;
-            }
-            let mut m = m;
-            for slot in n.first..n.first + n.count {
-                let prim = tr.slot_prim[slot as usize];
-                let hit = match tr.geometry.sphere_index(prim) {
-                    None => triangle::<L>(
-                        &tr.geometry.triangles[prim as usize],
-                        &prep,
-                        &o,
-                        &shear,
-                        &tmax,
-                        m,
-                        &mut out,
-                    ),
-                    Some(_) => sphere_lanes(tr, &prep, prim, &tmax, m, &mut out),
-                };
-                alive &= !hit;
-                m &= !hit;
-                if m == 0 {
-                    break;
+                Kind::Sphere(prim) => {
+                    stats.leaves += 1;
+                    let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
+                    while m != 0 {
+                        let l = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        if sphere.intersect(&rays.get(l)).is_some() {
+                            alive &= !(1 << l);
+                        }
+                    }
                 }
+                Kind::Empty => {}
             }
         }
-        active & !alive
+        if alive == 0 {
+            break;
+        }
     }
+    (active as u32 & !alive) as LaneMask
 }

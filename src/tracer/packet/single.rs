@@ -1,164 +1,253 @@
-//! Single-ray traversal of the BVH2: the packet kernel's tail for lanes that are left alone
-//! (Benthin et al. 2012), and the backend's single-ray entry points. Same primitive tests and
-//! the same conservative slab test as the packet kernel.
+//! Single-ray traversal of the wide BVH: the packet kernel's tail for lanes left alone
+//! (Benthin et al. 2012) and the backend's single-ray entry points. One 8-lane slab test covers
+//! all children of a node (near/far planes picked by the ray's direction signs, so empty slots
+//! miss without a test of their own); closest hit continues into the nearest child and stacks
+//! the others far to near with their entry distances, skipping any that the closest hit found
+//! since has passed; occlusion returns at the first hit.
 
-use super::{FAR_SCALE, Node, PacketTracer, STACK, TraceStats, safe_inv};
-use crate::geometry::triangle::WatertightRay;
-use crate::geometry::{Hit, Ray};
-use crate::tracer::NO_HIT;
+use super::build::{Kind, Node};
+use super::{Best, FAR_SCALE, FAULT_FAR_FIRST, PacketTracer, Ray1, STACK, TraceStats, leaf};
+use crate::geometry::Ray;
+use crate::simd::{Lanes, NARROW, Vector};
+use crate::tracer::cull_t;
+use std::mem::MaybeUninit;
 
-/// Closest hit so far of one ray.
-#[derive(Clone, Copy, Debug)]
-pub struct Best {
-    pub t: f32,
-    pub prim: u32,
-    pub u: f32,
-    pub v: f32,
+use super::build::Child;
+
+/// The ray's origin and reciprocal direction, splatted once.
+struct Splat<W> {
+    o: [W; 3],
+    inv: [W; 3],
 }
 
-impl Best {
-    pub fn new(tmax: f32) -> Self {
-        Best {
-            t: tmax,
-            prim: NO_HIT,
-            u: 0.0,
-            v: 0.0,
-        }
-    }
-
-    pub fn hit(&self) -> Option<Hit> {
-        (self.prim != NO_HIT).then_some(Hit {
-            t: self.t,
-            prim: self.prim,
-            u: self.u,
-            v: self.v,
-        })
-    }
-}
-
-struct Slab {
-    o: [f32; 3],
-    inv: [f32; 3],
-}
-
-impl Slab {
-    fn new(ray: &Ray) -> Self {
-        Slab {
-            o: ray.origin.to_array(),
-            inv: ray.dir.to_array().map(safe_inv),
-        }
-    }
-
-    /// Entry distance if the ray meets the box within (0, tmax).
+impl<W: Vector<NARROW>> Splat<W> {
     #[inline(always)]
-    fn hit(&self, n: &Node, tmax: f32) -> Option<f32> {
-        let mut near = 0.0f32;
-        let mut far = f32::INFINITY;
-        for a in 0..3 {
-            let t0 = (n.min[a] - self.o[a]) * self.inv[a];
-            let t1 = (n.max[a] - self.o[a]) * self.inv[a];
-            let (lo, hi) = if t0 < t1 { (t0, t1) } else { (t1, t0) };
-            near = if lo > near { lo } else { near };
-            far = if hi < far { hi } else { far };
+    fn new(r: &Ray1) -> Self {
+        Splat {
+            o: [W::splat(r.o[0]), W::splat(r.o[1]), W::splat(r.o[2])],
+            inv: [W::splat(r.inv[0]), W::splat(r.inv[1]), W::splat(r.inv[2])],
         }
-        let far = far * FAR_SCALE;
-        let far = if tmax < far { tmax } else { far };
-        (near <= far).then_some(near)
     }
 }
 
-/// Tests one primitive; returns (t, u, v) if it is hit in (0, tmax).
+/// Children whose box the ray meets within (0, cull), with their entry distances.
 #[inline(always)]
-pub fn prim_hit(
-    tr: &PacketTracer,
-    ray: &Ray,
-    wr: &WatertightRay,
-    prim: u32,
-) -> Option<(f32, f32, f32)> {
-    match tr.geometry.sphere_index(prim) {
-        None => tr.geometry.triangles[prim as usize]
-            .intersect(ray, wr)
-            .map(|h| (h.t, h.b1, h.b2)),
-        Some(s) => tr.geometry.spheres[s].intersect(ray).map(|t| (t, 0.0, 0.0)),
+fn slab<W: Vector<NARROW>>(
+    n: &Node,
+    r: &Ray1,
+    s: &Splat<W>,
+    cull: f32,
+    near_out: &mut [f32; NARROW],
+) -> u32 {
+    let mut near = W::splat(0.0);
+    let mut far = W::splat(f32::INFINITY);
+    for a in 0..3 {
+        let lo = r.near[a];
+        let hi = if lo < 3 { lo + 3 } else { lo - 3 };
+        let t0 = W::load(&n.b[lo]).sub(s.o[a]).mul(s.inv[a]);
+        let t1 = W::load(&n.b[hi]).sub(s.o[a]).mul(s.inv[a]);
+        near = t0.max(near);
+        far = t1.min(far);
+    }
+    let far = far.mul(W::splat(FAR_SCALE)).min(W::splat(cull));
+    near.store(near_out);
+    near.le(far)
+}
+
+/// A fixed-size stack of (child, entry distance) without initialising its storage.
+struct Stack {
+    e: [MaybeUninit<(Child, f32)>; STACK],
+    sp: usize,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack {
+            e: [const { MaybeUninit::uninit() }; STACK],
+            sp: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, c: Child, t: f32) {
+        // The build bounds depth · BRANCH by STACK, so this never overflows; indexing checks.
+        self.e[self.sp] = MaybeUninit::new((c, t));
+        self.sp += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(Child, f32)> {
+        if self.sp == 0 {
+            return None;
+        }
+        self.sp -= 1;
+        // SAFETY: entries below sp were written by push.
+        Some(unsafe { self.e[self.sp].assume_init() })
+    }
+
+    #[inline(always)]
+    fn get(&self, i: usize) -> (Child, f32) {
+        debug_assert!(i < self.sp);
+        // SAFETY: i < sp, written by push.
+        unsafe { self.e[i].assume_init() }
+    }
+
+    #[inline(always)]
+    fn set(&mut self, i: usize, e: (Child, f32)) {
+        self.e[i] = MaybeUninit::new(e);
     }
 }
 
-/// Closest hit below `best.t` in the subtree at `start`, front to back.
-pub fn closest(tr: &PacketTracer, ray: &Ray, start: u32, best: &mut Best, stats: &mut TraceStats) {
-    let slab = Slab::new(ray);
-    let wr = WatertightRay::new(ray.dir);
-    let mut stack = [0u32; STACK];
-    let mut sp = 0;
-    let Some(_) = slab.hit(&tr.nodes[start as usize], best.t) else {
-        stats.single_nodes += 1;
-        return;
-    };
-    stack[0] = start;
-    sp += 1;
-    while sp > 0 {
-        sp -= 1;
-        let n = tr.nodes[stack[sp] as usize];
-        stats.single_nodes += 1;
-        if n.count > 0 {
-            for slot in n.first..n.first + n.count {
-                let prim = tr.slot_prim[slot as usize];
-                let r = Ray::new(ray.origin, ray.dir, best.t);
-                if let Some((t, u, v)) = prim_hit(tr, &r, &wr, prim)
-                    && t < best.t
-                {
-                    *best = Best { t, prim, u, v };
+/// Closest hit in the subtree `start`, improving `best`. `visit` sees the entry distance of
+/// every leaf entered, in order (the visit-order test; a no-op elsewhere).
+#[inline(always)]
+pub fn closest<L: Lanes, const FAULT: u32>(
+    tr: &PacketTracer,
+    r: &Ray1,
+    start: Child,
+    best: &mut Best,
+    stats: &mut TraceStats,
+    visit: &mut impl FnMut(f32),
+) {
+    let s = Splat::<L::W>::new(r);
+    let g = &*tr.geometry;
+    let mut stack = Stack::new();
+    let (mut cur, mut cur_t) = (start, 0.0f32);
+    loop {
+        match cur.kind() {
+            Kind::Inner(i) => {
+                let n = &tr.wide.nodes[i as usize];
+                stats.single_nodes += 1;
+                let mut near = [0.0; NARROW];
+                let mut m = slab(n, r, &s, cull_t(best.t), &mut near);
+                if m != 0 {
+                    let first = m.trailing_zeros() as usize;
+                    m &= m - 1;
+                    if m == 0 {
+                        (cur, cur_t) = (n.child[first], near[first]);
+                        continue;
+                    }
+                    // Insert the hit children into the top of the stack, farthest deepest.
+                    let base = stack.sp;
+                    let far_first = FAULT & FAULT_FAR_FIRST != 0;
+                    let add = |slot: usize, stack: &mut Stack| {
+                        let e = (n.child[slot], near[slot]);
+                        let mut j = stack.sp;
+                        stack.push(e.0, e.1);
+                        while j > base {
+                            let below = stack.get(j - 1);
+                            let deeper = if far_first {
+                                below.1 > e.1
+                            } else {
+                                below.1 < e.1
+                            };
+                            if !deeper {
+                                break;
+                            }
+                            stack.set(j, below);
+                            j -= 1;
+                        }
+                        stack.set(j, e);
+                    };
+                    add(first, &mut stack);
+                    while m != 0 {
+                        let slot = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        add(slot, &mut stack);
+                    }
+                    (cur, cur_t) = stack.pop().unwrap();
+                    continue;
                 }
             }
-            continue;
+            Kind::Block(b, count) => {
+                stats.leaves += 1;
+                visit(cur_t);
+                leaf::block_closest::<L::W, FAULT>(
+                    &g.triangles,
+                    &tr.wide.blocks[b as usize],
+                    count,
+                    r,
+                    best,
+                );
+            }
+            Kind::Sphere(p) => {
+                stats.leaves += 1;
+                visit(cur_t);
+                let sphere = &g.spheres[g.sphere_index(p).unwrap()];
+                let tmax = best.test_tmax();
+                if let Some(t) = sphere.intersect(&Ray::new(r.ray.origin, r.ray.dir, tmax)) {
+                    best.offer(t, p, 0.0, 0.0);
+                }
+            }
+            Kind::Empty => {}
         }
-        let (a, b) = (n.first, n.first + 1);
-        let ha = slab.hit(&tr.nodes[a as usize], best.t);
-        let hb = slab.hit(&tr.nodes[b as usize], best.t);
-        match (ha, hb) {
-            (Some(ta), Some(tb)) => {
-                let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
-                stack[sp] = far;
-                stack[sp + 1] = near;
-                sp += 2;
+        loop {
+            let Some((c, t)) = stack.pop() else { return };
+            if t <= cull_t(best.t) {
+                (cur, cur_t) = (c, t);
+                break;
             }
-            (Some(_), None) => {
-                stack[sp] = a;
-                sp += 1;
-            }
-            (None, Some(_)) => {
-                stack[sp] = b;
-                sp += 1;
-            }
-            (None, None) => {}
         }
     }
 }
 
-/// Whether anything lies on (0, ray.tmax) in the subtree at `start`; exits at the first hit.
-pub fn occluded(tr: &PacketTracer, ray: &Ray, start: u32, stats: &mut TraceStats) -> bool {
-    let slab = Slab::new(ray);
-    let wr = WatertightRay::new(ray.dir);
-    let mut stack = [0u32; STACK];
-    stack[0] = start;
-    let mut sp = 1;
-    while sp > 0 {
-        sp -= 1;
-        let n = tr.nodes[stack[sp] as usize];
-        stats.single_nodes += 1;
-        if slab.hit(&n, ray.tmax).is_none() {
-            continue;
-        }
-        if n.count > 0 {
-            for slot in n.first..n.first + n.count {
-                if prim_hit(tr, ray, &wr, tr.slot_prim[slot as usize]).is_some() {
+/// Whether anything in the subtree `start` lies on (0, tmax); returns at the first hit.
+#[inline(always)]
+pub fn occluded<L: Lanes, const FAULT: u32>(
+    tr: &PacketTracer,
+    r: &Ray1,
+    start: Child,
+    stats: &mut TraceStats,
+) -> bool {
+    let s = Splat::<L::W>::new(r);
+    let g = &*tr.geometry;
+    let cull = cull_t(r.ray.tmax);
+    let mut stack = Stack::new();
+    let mut cur = start;
+    loop {
+        match cur.kind() {
+            Kind::Inner(i) => {
+                let n = &tr.wide.nodes[i as usize];
+                stats.single_nodes += 1;
+                let mut near = [0.0; NARROW];
+                let mut m = slab(n, r, &s, cull, &mut near);
+                if m != 0 {
+                    cur = n.child[m.trailing_zeros() as usize];
+                    m &= m - 1;
+                    while m != 0 {
+                        let slot = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        stack.push(n.child[slot], 0.0);
+                    }
+                    continue;
+                }
+            }
+            Kind::Block(b, count) => {
+                stats.leaves += 1;
+                if leaf::block_any::<L::W, FAULT>(
+                    &g.triangles,
+                    &tr.wide.blocks[b as usize],
+                    count,
+                    r,
+                ) {
                     return true;
                 }
             }
-            continue;
+            Kind::Sphere(p) => {
+                stats.leaves += 1;
+                if g.spheres[g.sphere_index(p).unwrap()]
+                    .intersect(&r.ray)
+                    .is_some()
+                {
+                    return true;
+                }
+            }
+            Kind::Empty => {}
         }
-        stack[sp] = n.first + 1;
-        stack[sp + 1] = n.first;
-        sp += 2;
+        match stack.pop() {
+            Some((c, _)) => cur = c,
+            None => return false,
+        }
     }
-    false
 }
