@@ -48,7 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 &store,
                 &scene,
                 integrand,
-                REFERENCE_SPP,
+                compare::Need::Spp(REFERENCE_SPP),
                 1,
                 threads,
             )?);

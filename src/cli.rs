@@ -1,7 +1,7 @@
 //! The `dibench` command line.
 
 use crate::error::{Error, Result};
-use crate::harness::{compare, crosscheck, rays, reference};
+use crate::harness::{compare, crosscheck, pilot, rays, reference};
 use crate::prepare::PreparedScene;
 use crate::scene::Scene;
 use crate::simd::Isa;
@@ -9,6 +9,7 @@ use crate::strategy::{self, Strategy};
 use crate::tracer::backends;
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 #[derive(Parser, Debug)]
 #[command(
@@ -138,9 +139,18 @@ pub struct CompareArgs {
     /// Wall-clock budget per strategy, in seconds.
     #[arg(long, default_value_t = 2.0, value_parser = parse_seconds, allow_hyphen_values = true)]
     pub time: f64,
-    /// Samples per pixel of the reference rendered when no matching one is stored.
-    #[arg(long, default_value_t = 8192, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
-    pub reference_spp: u64,
+    /// Samples per pixel of the reference, fixed; by default a pilot of every strategy sizes
+    /// the reference by its noise floor instead (`--reference-floor`).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
+    pub reference_spp: Option<u64>,
+    /// The reference's noise floor as a share of the smallest RMSE the pilot predicts for the
+    /// compared strategies; also the share above which the result warns.
+    #[arg(long, default_value_t = 0.1, value_parser = parse_fraction, allow_hyphen_values = true)]
+    pub reference_floor: f64,
+    /// Longest a reference renders to reach its floor, in seconds; past it the reference
+    /// stops and says what floor it reached.
+    #[arg(long, default_value_t = 1800.0, value_parser = parse_seconds, allow_hyphen_values = true)]
+    pub reference_cap: f64,
     /// Comma-separated subset of strategies to run (default: every applicable one).
     #[arg(long, value_delimiter = ',')]
     pub strategies: Option<Vec<String>>,
@@ -208,6 +218,13 @@ fn parse_alpha(s: &str) -> std::result::Result<f64, String> {
     match s.trim().parse::<f64>() {
         Ok(a) if a > 0.0 && a < 1.0 => Ok(a),
         _ => Err("expected a significance level strictly between 0 and 1".into()),
+    }
+}
+
+fn parse_fraction(s: &str) -> std::result::Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(a) if a > 0.0 && a <= 1.0 => Ok(a),
+        _ => Err("expected a share greater than 0 and at most 1".into()),
     }
 }
 
@@ -647,20 +664,67 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
     crate::output::check_output_dir(&a.common.out, "--out")?;
     let run_dir = compare::create_run_dir(&a.common.out, &scene.scene.name, seed)?;
     let store = reference::store(&a.common.out, &scene.scene.name)?;
-    for k in &skipped {
-        eprintln!("skipping strategy `{}`: {}", k.name, k.reason);
+    if !skipped.is_empty() {
+        // One line; the reasons are in run.json and `dibench strategies SCENE`.
+        let names: Vec<&str> = skipped.iter().map(|k| k.name.as_str()).collect();
+        eprintln!(
+            "skipping {} strategies that do not apply to this scene ({}); why: `dibench strategies {}`",
+            names.len(),
+            abbreviate(&names, 4),
+            scene.scene.name
+        );
     }
     let result = pool.install(|| -> Result<()> {
+        // Without a fixed --reference-spp, pilots size each reference (`harness::pilot`).
+        let plans = match a.reference_spp {
+            Some(_) => Vec::new(),
+            None => {
+                let each = Duration::from_secs_f64((0.05 * a.time).clamp(0.25, 2.0));
+                eprintln!(
+                    "pilot: {} strategies, {:.1} s each, to size the reference",
+                    run.len(),
+                    each.as_secs_f64()
+                );
+                let pilots = run
+                    .iter()
+                    .map(|s| pilot::pilot(&scene, s.as_ref(), a.common.seed, each))
+                    .collect::<Result<Vec<_>>>()?;
+                if crate::interrupt::requested() {
+                    return Err(Error::Interrupted("compare stopped during the pilot".into()));
+                }
+                pilot::plan(&pilots, a.time, a.reference_floor)
+            }
+        };
         let mut images = Vec::new();
         for integrand in strategy::integrands(&scene) {
             if !run.iter().any(|s| s.integrand() == integrand) {
                 continue;
             }
+            let need = match a.reference_spp {
+                Some(spp) => compare::Need::Spp(spp),
+                None => {
+                    let plan = plans.iter().find(|p| p.integrand == integrand);
+                    let strategy = plan
+                        .and_then(|p| run.iter().find(|s| s.name() == p.strategy))
+                        .map(|s| s.as_ref());
+                    let (Some(plan), Some(strategy)) = (plan, strategy) else {
+                        return Err(Error::Usage(format!(
+                            "no pilot sized the {} reference",
+                            integrand.name()
+                        )));
+                    };
+                    compare::Need::Floor {
+                        plan,
+                        strategy,
+                        cap_s: a.reference_cap,
+                    }
+                }
+            };
             images.push(compare::Reference::load_or_render(
                 &store,
                 &scene,
                 integrand,
-                a.reference_spp,
+                need,
                 a.common.seed,
                 threads,
             )?);
@@ -688,39 +752,6 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
             a.time,
             spp.join(", ")
         );
-        let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
-        println!(
-            "{:<20} {:>9} {:>4} {:>8} {:>8} {:>10} {:>9} {:>10} {:>9} {:>10} {:>10} {:>6}",
-            "strategy",
-            "integrand",
-            "runs",
-            "spp",
-            "time_s",
-            "rmse",
-            "±95%",
-            "relmse",
-            "±95%",
-            "pred_rmse",
-            "efficiency",
-            "vs_best"
-        );
-        for r in &report.summary {
-            println!(
-                "{:<20} {:>9} {:>4} {:>8.0} {:>8.3} {:>10.3e} {:>9} {:>10.3e} {:>9} {:>10.3e} {:>10.3e} {:>6}",
-                r.strategy,
-                r.integrand,
-                r.runs,
-                r.spp_mean,
-                r.time_s_mean,
-                r.rmse_mean,
-                ci(r.rmse_ci95),
-                r.relmse_mean,
-                ci(r.relmse_ci95),
-                r.predicted_rmse,
-                r.efficiency,
-                r.vs_best
-            );
-        }
         let overshoot = report
             .summary
             .iter()
@@ -733,15 +764,53 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
         for floor in &references.images {
             if let Some(f) = floor.noise_floor {
                 println!(
-                    "reference ({}) noise floor: {f:.3e} RMSE",
+                    "reference ({}) noise floor: {f:.3e} RMSE; debiased columns subtract it",
                     floor.integrand.name()
                 );
             }
         }
-        for w in compare_warnings(&report.summary) {
+        println!("results: {}", report.run_dir.display());
+        for w in crate::harness::summary::noise_floor_warnings(&report.summary, a.reference_floor) {
             eprintln!("{w}");
         }
-        println!("results: {}", report.run_dir.display());
+        // The table last, ranked by the debiased relMSE (see `harness::summary`).
+        let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
+        let opt = |x: Option<f64>, p: usize| x.map_or("-".to_string(), |v| format!("{v:.p$}"));
+        let opt_e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
+        println!(
+            "{:<20} {:>9} {:>4} {:>8} {:>10} {:>9} {:>10} {:>10} {:>9} {:>6} {:>10} {:>10} {}",
+            "strategy",
+            "integrand",
+            "runs",
+            "spp",
+            "rmse",
+            "±95%",
+            "rmse_deb",
+            "relmse_deb",
+            "±95%",
+            "slope",
+            "pred_rmse",
+            "efficiency",
+            "vs_best (Holm)"
+        );
+        for r in &report.summary {
+            println!(
+                "{:<20} {:>9} {:>4} {:>8.0} {:>10.3e} {:>9} {:>10} {:>10.3e} {:>9} {:>6} {:>10.3e} {:>10.3e} {}",
+                r.strategy,
+                r.integrand,
+                r.runs,
+                r.spp_mean,
+                r.rmse_mean,
+                ci(r.rmse_ci95),
+                opt_e(r.rmse_debiased),
+                r.relmse_debiased_mean,
+                ci(r.relmse_debiased_ci95),
+                opt(r.slope_time_mean, 2),
+                r.predicted_rmse,
+                r.efficiency,
+                r.vs_best
+            );
+        }
         Ok(())
     });
     if let Err(e) = &result {
@@ -750,8 +819,13 @@ fn run_compare(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()>
     result
 }
 
-fn compare_warnings(rows: &[crate::harness::summary::SummaryRow]) -> Vec<String> {
-    crate::harness::summary::noise_floor_warnings(rows)
+
+/// The first `n` of `names`, then how many more.
+fn abbreviate(names: &[&str], n: usize) -> String {
+    match names.len() {
+        k if k <= n => names.join(", "),
+        k => format!("{}, … {} more", names[..n].join(", "), k - n),
+    }
 }
 
 /// The ISA path the chosen backend runs, for run metadata.

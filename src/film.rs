@@ -55,15 +55,21 @@ pub struct Film {
 }
 
 /// Adds sample `x` as the (n+1)-th to a pixel's running sum and M2 (Welford 1962, written
-/// with the sum rather than the mean so the film's sums stay exact sums).
+/// with the sum rather than the mean so the film's sums stay exact sums). The update is
+/// M2 += d²·n/(n+1) with d = x − sum/n, a sum of non-negative terms: M2 is never negative,
+/// so neither is any variance derived from it (the form M2 += (x − m_old)(x − m_new) can go
+/// below zero by rounding when every sample is equal).
 #[inline]
 pub fn accumulate(sum: &mut [f64; 3], m2: &mut [f64; 3], n: u64, x: [f64; 3]) {
-    let inv_old = if n == 0 { 0.0 } else { 1.0 / n as f64 };
-    let inv_new = 1.0 / (n + 1) as f64;
+    if n == 0 {
+        *sum = x;
+        return;
+    }
+    let (nf, w) = (n as f64, n as f64 / (n + 1) as f64);
     for c in 0..3 {
-        let mean_old = sum[c] * inv_old;
+        let d = x[c] - sum[c] / nf;
+        m2[c] += d * d * w;
         sum[c] += x[c];
-        m2[c] += (x[c] - mean_old) * (x[c] - sum[c] * inv_new);
     }
 }
 
@@ -102,12 +108,9 @@ impl Film {
 
     /// The mean image in scan-line order.
     pub fn mean(&self) -> Image {
-        let inv = if self.spp == 0 {
-            0.0
-        } else {
-            1.0 / self.spp as f64
-        };
-        self.scan_lines(&self.sum, inv)
+        // sum / n, not sum · (1/n): the rounded reciprocal moves a constant pixel off its value.
+        let n = self.spp.max(1) as f64;
+        self.scan_lines(&self.sum, |s| s / n)
     }
 
     /// Per-pixel variance of the mean image (sample variance / spp), in scan-line order: the
@@ -119,7 +122,7 @@ impl Film {
         } else {
             1.0 / ((n - 1.0) * n)
         };
-        self.scan_lines(&self.m2, scale)
+        self.scan_lines(&self.m2, |m| m * scale)
     }
 
     /// Mean over pixels and channels of the per-sample variance: σ² of the 1-spp estimator,
@@ -133,13 +136,13 @@ impl Film {
             / (self.spp - 1) as f64
     }
 
-    fn scan_lines(&self, data: &[[f64; 3]], scale: f64) -> Image {
+    fn scan_lines(&self, data: &[[f64; 3]], f: impl Fn(f64) -> f64) -> Image {
         let TileLayout { width, height, .. } = self.layout;
         let mut pixels = Vec::with_capacity((width * height) as usize);
         for y in 0..height {
             for x in 0..width {
                 let s = data[self.layout.index(x, y)];
-                pixels.push([s[0] * scale, s[1] * scale, s[2] * scale]);
+                pixels.push([f(s[0]), f(s[1]), f(s[2])]);
             }
         }
         Image {
@@ -183,5 +186,26 @@ mod tests {
         assert!((m2[0] - w.m2()).abs() < 1e-9 * w.m2());
         assert!((m2[1] - 4.0 * w.m2()).abs() < 1e-9 * w.m2());
         assert_eq!(m2[2], 0.0);
+    }
+
+    /// Constant samples give a variance of exactly zero or more, never below (the old update
+    /// (x − m_old)(x − m_new) gave about −1e-35 on such pixels, and a NaN noise floor from it);
+    /// and the mean of a constant pixel is the constant.
+    #[test]
+    fn constant_pixels_have_non_negative_variance_and_exact_mean() {
+        for &x in &[0.1f64, 1.0 / 3.0, 0.7, 2.9e-3, 123.456, 1e-30] {
+            let mut film = Film::new(1, 1);
+            let i = film.layout.index(0, 0);
+            for n in 0..1000u64 {
+                let (s, m) = (&mut film.sum[i], &mut film.m2[i]);
+                accumulate(s, m, n, [x, x, x]);
+                assert!(m.iter().all(|&v| v >= 0.0), "x = {x}, n = {n}: M2 {m:?}");
+            }
+            film.spp = 1000;
+            assert!(film.variance_of_mean().pixels[0].iter().all(|&v| v >= 0.0));
+            assert!(film.mean_sample_variance() >= 0.0);
+            let rel = (film.mean().pixels[0][0] - x).abs() / x;
+            assert!(rel <= 1e-13, "x = {x}: mean off by {rel}");
+        }
     }
 }

@@ -14,11 +14,13 @@ pub fn rmse(img: &Image, reference: &Image) -> f64 {
     (se / n).sqrt()
 }
 
+/// The ε of relMSE's denominator r² + ε.
+pub const EPS: f64 = 0.01;
+
 /// Relative MSE, mean over pixels and channels of (x - r)² / (r² + ε) with ε = 0.01
 /// (Rousselle et al. 2011): the ε is part of the metric's definition, so dark pixels do not
 /// dominate.
 pub fn relmse(img: &Image, reference: &Image) -> f64 {
-    const EPS: f64 = 0.01;
     let n = (img.pixels.len() * 3) as f64;
     let s: f64 = img
         .pixels
@@ -29,6 +31,23 @@ pub fn relmse(img: &Image, reference: &Image) -> f64 {
                 .map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + EPS))
                 .sum::<f64>()
         })
+        .sum();
+    s / n
+}
+
+/// The relMSE a reference's own noise adds in expectation: mean over pixels and channels of
+/// Var(r) / (r² + ε), with `variance` the per-pixel variance of the reference mean. For an
+/// image x independent of the reference r (their random streams never coincide),
+/// E[(x − r)²] = E[(x − μ)²] + Var(r), so relMSE − this is the relMSE against the truth, up to
+/// evaluating the weight 1/(r² + ε) at r instead of μ (a relative error of order
+/// Var(r)/(r² + ε), small where the reference is good enough to compare against).
+pub fn relmse_floor(variance: &Image, reference: &Image) -> f64 {
+    let n = (reference.pixels.len() * 3) as f64;
+    let s: f64 = variance
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(v, b)| (0..3).map(|c| v[c] / (b[c] * b[c] + EPS)).sum::<f64>())
         .sum();
     s / n
 }

@@ -94,8 +94,10 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
     assert_eq!(
         lines.next().unwrap(),
         "scene,integrand,strategy,runs,budget_s,time_s_mean,overshoot_max,spp_mean,rmse_mean,\
-         rmse_ci95,relmse_mean,relmse_ci95,efficiency,predicted_rmse,reference_noise_floor,\
-         welch_p_vs_best,vs_best"
+         rmse_ci95,rmse_debiased,mse_debiased_mean,mse_debiased_ci95,relmse_mean,relmse_ci95,\
+         relmse_debiased_mean,relmse_debiased_ci95,efficiency,predicted_rmse,\
+         reference_noise_floor,slope_time_mean,slope_time_ci95,slope_spp_mean,welch_p_vs_best,\
+         holm_p_vs_best,vs_best"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{summary}");
@@ -103,13 +105,22 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
         assert_eq!(r[3], "3", "runs: {summary}");
         let ci: f64 = r[9].parse().expect("an RMSE CI with 3 runs");
         assert!(ci.is_finite() && ci >= 0.0);
-        let floor: f64 = r[14].parse().expect("a reference noise floor");
+        let floor: f64 = r[19].parse().expect("a reference noise floor");
         assert!(floor > 0.0 && floor.is_finite());
+        // Debiased MSE = MSE − floor² exactly (the mean of per-run differences).
+        let (rmse, mse_d): (f64, f64) = (r[8].parse().unwrap(), r[11].parse().unwrap());
+        assert!(mse_d < rmse * rmse, "{summary}");
+        let slope: f64 = r[20].parse().expect("a convergence slope");
+        assert!(slope.is_finite() && slope < 0.0, "slope {slope}: {summary}");
+        if !r[23].is_empty() {
+            let (raw, holm): (f64, f64) = (r[23].parse().unwrap(), r[24].parse().unwrap());
+            assert!(holm >= raw && holm <= 1.0, "{summary}");
+        }
     }
     // One best per integrand: light vs cosine for direct, ao-cosine alone for AO.
     let best: Vec<_> = rows
         .iter()
-        .filter(|r| r[16] == "best")
+        .filter(|r| r[25] == "best")
         .map(|r| r[2])
         .collect();
     assert_eq!(best.len(), 2, "{summary}");

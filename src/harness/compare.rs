@@ -184,28 +184,53 @@ pub struct Reference {
     /// RMSE the reference's own noise adds to every measured RMSE (see `reference`); None
     /// for references stored before it was tracked.
     pub noise_floor: Option<f64>,
+    /// What the reference's noise adds to a measured relMSE in expectation: the mean over
+    /// pixels and channels of Var(r) / (r² + ε), the relMSE's own weighting (see
+    /// `metrics::relmse_floor`).
+    pub relmse_floor: f64,
 }
 
 pub struct References {
     pub images: Vec<Reference>,
 }
 
+/// What a reference must be to serve: a fixed sample count (`--reference-spp`), or a noise
+/// floor planned from pilots (`pilot::plan`), rendered with the plan's strategy within a cap.
+pub enum Need<'a> {
+    Spp(u64),
+    Floor {
+        plan: &'a super::pilot::Plan,
+        strategy: &'a dyn Strategy,
+        cap_s: f64,
+    },
+}
+
 impl Reference {
-    /// The stored reference of `integrand` with at least `spp` samples for this exact scene
-    /// content, else a fresh one rendered (with `seed`) and stored. Says which on stderr. The
-    /// unit stays locked while it renders, so a concurrent run waits and then reuses it.
+    /// The stored reference of `integrand` that meets `need` for this exact scene content,
+    /// else a fresh one rendered (with `seed`) and stored. Says which on stderr. The unit stays
+    /// locked while it renders, so a concurrent run waits and then reuses it.
     pub fn load_or_render(
         store: &Store,
         scene: &PreparedScene,
         integrand: Integrand,
-        spp: u64,
+        need: Need,
         seed: u64,
         threads: usize,
     ) -> Result<Reference> {
-        use super::reference;
+        use super::reference::{self, Budget};
         let dir = store.dir();
         let unit = store.lock(integrand.name())?;
-        let (image, meta) = match reference::load_matching(&unit, scene, spp)? {
+        let min_spp = match need {
+            Need::Spp(n) => n,
+            Need::Floor { .. } => 1,
+        };
+        let stored = reference::load_matching(&unit, scene, min_spp)?.filter(|(_, meta)| match &need {
+            Need::Spp(_) => true,
+            Need::Floor { plan, .. } => meta
+                .noise_floor_rmse
+                .is_some_and(|f| f <= plan.target_floor),
+        });
+        let (image, meta, variance) = match stored {
             Some(r) => {
                 eprintln!(
                     "reference ({}): reusing {} spp from {}",
@@ -213,26 +238,70 @@ impl Reference {
                     r.1.spp,
                     dir.display()
                 );
-                r
+                let variance = reference::load_variance(&unit, r.0.width, r.0.height)?;
+                (r.0, r.1, variance)
             }
             None => {
-                eprintln!(
-                    "reference ({}): rendering {spp} spp (no matching one stored)",
-                    integrand.name()
-                );
-                let r = reference::render(scene, integrand, spp, seed, threads)?;
+                let r = match need {
+                    Need::Spp(spp) => {
+                        eprintln!(
+                            "reference ({}): rendering {spp} spp (no matching one stored)",
+                            integrand.name()
+                        );
+                        reference::render(scene, integrand, spp, seed, threads)?
+                    }
+                    Need::Floor {
+                        plan,
+                        strategy,
+                        cap_s,
+                    } => {
+                        eprintln!(
+                            "reference ({}): rendering with `{}` to a noise floor of {:.2e} \
+                             ({:.0} % of the smallest predicted RMSE, {:.2e} by `{}`): about \
+                             {} spp, {:.0} s",
+                            integrand.name(),
+                            plan.strategy,
+                            plan.target_floor,
+                            100.0 * plan.target_floor / plan.smallest_rmse,
+                            plan.smallest_rmse,
+                            plan.smallest_by,
+                            plan.predicted_spp,
+                            plan.predicted_s
+                        );
+                        let budget = Budget::Floor {
+                            target: plan.target_floor,
+                            cap: cap_s,
+                            expected_spp: plan.predicted_spp,
+                        };
+                        let r =
+                            reference::render_with(scene, strategy, budget, seed, threads, None)?;
+                        let floor = r.meta.noise_floor_rmse.unwrap_or(0.0);
+                        if floor > plan.target_floor {
+                            eprintln!(
+                                "reference ({}): stopped at the cap of {cap_s} s \
+                                 (--reference-cap) with a noise floor of {floor:.2e}, above \
+                                 the target {:.2e}",
+                                integrand.name(),
+                                plan.target_floor
+                            );
+                        }
+                        r
+                    }
+                };
                 reference::save(&unit, &r.image, &r.variance, &r.meta)?;
                 eprintln!(
-                    "reference ({}): {:.1} s with `{}`",
+                    "reference ({}): {} spp in {:.1} s with `{}`",
                     integrand.name(),
+                    r.meta.spp,
                     r.meta.wall_time_s,
                     r.meta.strategy
                 );
-                (r.image, r.meta)
+                (r.image, r.meta, r.variance)
             }
         };
         Ok(Reference {
             integrand,
+            relmse_floor: crate::metrics::relmse_floor(&variance, &image),
             image,
             spp: meta.spp,
             noise_floor: meta.noise_floor_rmse,
@@ -354,12 +423,15 @@ pub fn run(
                 write_exr(&dir.join(format!("{}.exr", s.name())), &r.image)?;
                 write_exr(&dir.join(format!("{}.variance.exr", s.name())), &r.variance)?;
             }
-            let last = r.rows.last().cloned().expect("a run has a final row");
-            finals.push(FinalRun {
-                row: last,
-                mean_sample_variance: r.mean_sample_variance,
-                reference_noise_floor: reference.noise_floor,
-            });
+            let Some(last) = FinalRun::new(
+                &r.rows,
+                r.mean_sample_variance,
+                reference.noise_floor,
+                reference.relmse_floor,
+            ) else {
+                return Err(Error::Usage(format!("`{}` (run {run}) left no rows", s.name())));
+            };
+            finals.push(last);
             rows.extend(r.rows);
             write_csv(&dir.join("results.csv"), &rows)?;
             run_dir.keep();

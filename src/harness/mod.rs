@@ -2,6 +2,7 @@
 
 pub mod compare;
 pub mod crosscheck;
+pub mod pilot;
 pub mod rays;
 pub mod raysets;
 pub mod reference;

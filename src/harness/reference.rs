@@ -75,6 +75,14 @@ pub enum Budget {
     Spp(u64),
     /// Whole passes until the time is spent (at least one).
     Time(f64),
+    /// Whole passes until the noise floor is at most `target` (checked every few passes, after
+    /// `pilot::MIN_PASSES`) or until `cap` seconds are spent; `expected_spp` sizes the
+    /// progress bar.
+    Floor {
+        target: f64,
+        cap: f64,
+        expected_spp: u64,
+    },
 }
 
 /// The first progressive checkpoint; later ones at 2×, 4×, ... (a crash loses at most half).
@@ -108,22 +116,45 @@ pub fn render_progressive(
     threads: usize,
     checkpoints: Option<&Locked>,
 ) -> Result<Rendered> {
-    let (spp, time) = match budget {
+    match budget {
         Budget::Spp(0) => return Err(Error::Usage("--spp must be at least 1".into())),
-        Budget::Spp(n) => (n, None),
-        Budget::Time(t) => match Duration::try_from_secs_f64(t) {
-            Ok(d) if d > Duration::ZERO => (u64::MAX, Some(d)),
-            _ => {
-                return Err(Error::Usage(format!(
-                    "--time must be a positive number of seconds, got {t}"
-                )));
-            }
-        },
-    };
+        Budget::Time(t) if !Duration::try_from_secs_f64(t).is_ok_and(|d| d > Duration::ZERO) => {
+            return Err(Error::Usage(format!(
+                "--time must be a positive number of seconds, got {t}"
+            )));
+        }
+        _ => {}
+    }
     let strategy = strategy_for(scene, integrand)?;
-    let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
+    render_with(scene, strategy.as_ref(), budget, seed, threads, checkpoints)
+}
+
+/// [`render_progressive`] with a given strategy (its integrand is the reference's).
+pub fn render_with(
+    scene: &PreparedScene,
+    strategy: &dyn crate::strategy::Strategy,
+    budget: Budget,
+    seed: u64,
+    threads: usize,
+    checkpoints: Option<&Locked>,
+) -> Result<Rendered> {
+    let integrand = strategy.integrand();
+    let (spp, time, floor) = match budget {
+        Budget::Floor {
+            target,
+            cap,
+            expected_spp,
+        } => (
+            expected_spp,
+            Some(Duration::try_from_secs_f64(cap).unwrap_or(Duration::MAX)),
+            Some(target),
+        ),
+        Budget::Spp(n) => (n, None, None),
+        Budget::Time(t) => (u64::MAX, Some(Duration::from_secs_f64(t)), None),
+    };
+    let mut renderer = Renderer::new(scene, strategy, reference_stream_seed(seed))?;
     let bar = progress_bar(
-        if time.is_some() { 0 } else { spp },
+        if time.is_some() && floor.is_none() { 0 } else { spp },
         format!("reference {} {}", scene.scene.name, integrand.name()),
         "{prefix} [{bar:30}] {pos}/{len} spp, eta {eta}",
     );
@@ -141,7 +172,7 @@ pub fn render_progressive(
         backend: scene.tracer.name().to_string(),
         threads,
         wall_time_s: start.elapsed().as_secs_f64(),
-        noise_floor_rmse: Some((film.mean_sample_variance() / film.spp as f64).sqrt()),
+        noise_floor_rmse: Some(noise_floor(film)),
         dibench_version: VERSION.to_string(),
         commit: COMMIT.to_string(),
     };
@@ -162,9 +193,15 @@ pub fn render_progressive(
                 film.spp
             )));
         }
-        let done = match time {
-            Some(t) => film.spp > 0 && start.elapsed() >= t,
-            None => film.spp >= spp,
+        let done = match (floor, time) {
+            // The floor is an O(pixels) sum: looked at every 8 passes, a small share of them.
+            (Some(target), Some(cap)) => {
+                film.spp >= super::pilot::MIN_PASSES
+                    && (start.elapsed() >= cap
+                        || (film.spp % 8 == 0 && noise_floor(&film) <= target))
+            }
+            (_, Some(t)) => film.spp > 0 && start.elapsed() >= t,
+            (_, None) => film.spp >= spp,
         };
         if done {
             break;
@@ -199,6 +236,11 @@ pub fn render_progressive(
         variance: film.variance_of_mean(),
         meta: meta_of(&film),
     })
+}
+
+/// √(σ²/N): the RMSE the reference's noise adds to a measured RMSE (see `ReferenceMeta`).
+pub fn noise_floor(film: &Film) -> f64 {
+    (film.mean_sample_variance() / film.spp.max(1) as f64).sqrt()
 }
 
 /// Commits the reference (image, per-pixel variance of the mean, metadata) as the content of
@@ -260,12 +302,45 @@ pub fn load_matching(
     if let Some(k) = pixels.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
         return Err(bad(format!("pixel {k} is not finite")));
     }
-    Ok(Some((
-        Image {
-            width: meta.width,
-            height: meta.height,
-            pixels,
-        },
-        meta,
-    )))
+    let image = Image {
+        width: meta.width,
+        height: meta.height,
+        pixels,
+    };
+    Ok(Some((image, meta)))
+}
+
+/// The stored per-pixel variance of the reference mean of `unit` (as [`load_matching`] found
+/// it), checked to match the image's size and to be finite and non-negative.
+pub fn load_variance(unit: &Locked, width: u32, height: u32) -> Result<Image> {
+    let Some(stored) = unit.read::<ReferenceMeta>()? else {
+        return Err(Error::Output {
+            path: unit.manifest_path(),
+            message: "the reference vanished while locked".into(),
+        });
+    };
+    let (path, bytes) = stored.file("variance")?;
+    let (w, h, pixels) = decode_exr(bytes, path, |r, g, b| [r as f64, g as f64, b as f64])?;
+    let bad = |message: String| Error::Parse {
+        path: path.to_path_buf(),
+        message,
+    };
+    if (w, h) != (width as usize, height as usize) {
+        return Err(bad(format!(
+            "{w}×{h} pixels, but its image has {width}×{height}"
+        )));
+    }
+    if let Some(k) = pixels
+        .iter()
+        .position(|p| !p.iter().all(|c| c.is_finite() && *c >= 0.0))
+    {
+        return Err(bad(format!(
+            "pixel {k} is not a variance (negative or not finite)"
+        )));
+    }
+    Ok(Image {
+        width,
+        height,
+        pixels,
+    })
 }

@@ -3,7 +3,7 @@
 //! best strategy (Celarek et al. 2019, "Quantifying the Error of Light Transport Algorithms").
 
 use super::compare::ResultRow;
-use crate::stats::{mean_ci, welch_t_test};
+use crate::stats::{fit_line, holm_adjust, mean_ci, welch_t_test};
 use serde::{Deserialize, Serialize};
 
 /// Confidence level of the intervals and the significance level α = 1 − level of the tests.
@@ -16,6 +16,62 @@ pub struct FinalRun {
     /// σ² of the 1-spp estimator, mean over pixels and channels.
     pub mean_sample_variance: f64,
     pub reference_noise_floor: Option<f64>,
+    /// What the reference's noise adds to relMSE in expectation (`metrics::relmse_floor`).
+    pub reference_relmse_floor: f64,
+    /// Slopes of log RMSE against log time and against log spp over this run's checkpoints.
+    pub slope_time: Option<f64>,
+    pub slope_spp: Option<f64>,
+}
+
+impl FinalRun {
+    /// The run's final row with the slopes of its checkpoint rows `rows`.
+    pub fn new(
+        rows: &[ResultRow],
+        mean_sample_variance: f64,
+        reference_noise_floor: Option<f64>,
+        reference_relmse_floor: f64,
+    ) -> Option<FinalRun> {
+        let row = rows.last()?.clone();
+        let (slope_time, slope_spp) = convergence_slopes(rows);
+        Some(FinalRun {
+            row,
+            mean_sample_variance,
+            reference_noise_floor,
+            reference_relmse_floor,
+            slope_time,
+            slope_spp,
+        })
+    }
+
+    /// MSE against the truth, debiased: measured MSE − floor² (an unbiased estimate, so it may
+    /// be negative when the error is below what the reference resolves).
+    pub fn mse_debiased(&self) -> f64 {
+        let floor2 = self.reference_noise_floor.map_or(0.0, |f| f * f);
+        self.row.rmse * self.row.rmse - floor2
+    }
+
+    pub fn relmse_debiased(&self) -> f64 {
+        self.row.relmse - self.reference_relmse_floor
+    }
+}
+
+/// Least-squares slopes of ln RMSE against ln time and ln spp over checkpoint rows (at least
+/// three with positive values): −½ for an unbiased estimator with independent samples.
+pub fn convergence_slopes(rows: &[ResultRow]) -> (Option<f64>, Option<f64>) {
+    let ok: Vec<&ResultRow> = rows
+        .iter()
+        .filter(|r| r.rmse > 0.0 && r.time_s > 0.0 && r.spp > 0)
+        .collect();
+    if ok.len() < 3 {
+        return (None, None);
+    }
+    let y: Vec<f64> = ok.iter().map(|r| r.rmse.ln()).collect();
+    let t: Vec<f64> = ok.iter().map(|r| r.time_s.ln()).collect();
+    let n: Vec<f64> = ok.iter().map(|r| (r.spp as f64).ln()).collect();
+    (
+        fit_line(&t, &y).map(|f| f.slope),
+        fit_line(&n, &y).map(|f| f.slope),
+    )
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -32,22 +88,42 @@ pub struct SummaryRow {
     pub rmse_mean: f64,
     /// Half-width of the 95 % Student-t interval of the mean over runs (empty below 2 runs).
     pub rmse_ci95: Option<f64>,
+    /// √ of the debiased MSE (MSE − floor², mean over runs); empty when that mean is not
+    /// positive (the error is below what the reference resolves).
+    pub rmse_debiased: Option<f64>,
+    /// The debiased MSE, mean over runs, and its interval.
+    pub mse_debiased_mean: f64,
+    pub mse_debiased_ci95: Option<f64>,
     pub relmse_mean: f64,
     pub relmse_ci95: Option<f64>,
-    /// Veach's efficiency 1 / (relMSE · t), with the mean relMSE and mean time.
+    /// relMSE − the reference's relMSE floor (`metrics::relmse_floor`), mean over runs: the
+    /// ranking metric.
+    pub relmse_debiased_mean: f64,
+    pub relmse_debiased_ci95: Option<f64>,
+    /// Veach's efficiency 1 / (relMSE · t), with the mean relMSE and mean time (the raw relMSE:
+    /// the debiased one may be zero or negative).
     pub efficiency: f64,
     /// √(σ² · (t/spp) / T + floor²): the RMSE expected from the per-sample variance σ², the
     /// measured cost per sample t/spp and the budget T, plus the reference's noise floor.
     pub predicted_rmse: f64,
     pub reference_noise_floor: Option<f64>,
-    /// Two-sided p-value of Welch's t-test of this strategy's per-run relMSE against the
-    /// best strategy's (same integrand); empty for the best one and below 2 runs.
+    /// Slope of ln RMSE against ln time over each run's checkpoints, mean over runs, with its
+    /// interval; and against ln spp. −½ for independent samples.
+    pub slope_time_mean: Option<f64>,
+    pub slope_time_ci95: Option<f64>,
+    pub slope_spp_mean: Option<f64>,
+    /// Two-sided p-value of Welch's t-test of this strategy's per-run debiased relMSE against
+    /// the best strategy's (same integrand); empty for the best one and below 2 runs.
     pub welch_p_vs_best: Option<f64>,
-    /// `best`, `worse` (p < 0.05), `tie` (not significantly different) or `n/a` (one run).
+    /// That p-value adjusted by Holm–Bonferroni over the family of every pairwise comparison
+    /// among the strategies of this integrand (so the choice of the best is covered too).
+    pub holm_p_vs_best: Option<f64>,
+    /// `best`; `worse` (Holm-adjusted p < 0.05) or `tie`; `one run: no test` below 2 runs.
     pub vs_best: String,
 }
 
-/// One summary row per (integrand, strategy), in order of first appearance.
+/// One summary row per (integrand, strategy), sorted per integrand by the ranking metric (the
+/// debiased relMSE), integrands in order of first appearance.
 pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
     let mut keys: Vec<(&str, &str)> = Vec::new();
     for f in finals {
@@ -62,14 +138,22 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
             .filter(|f| (f.row.integrand.as_str(), f.row.strategy.as_str()) == *k)
             .collect()
     };
+    let debiased = |k: &(&str, &str)| -> Vec<f64> {
+        group(k).iter().map(|f| f.relmse_debiased()).collect()
+    };
     let mut rows: Vec<SummaryRow> = keys
         .iter()
         .map(|k| {
             let g = group(k);
-            let pick = |f: fn(&FinalRun) -> f64| g.iter().map(|r| f(r)).collect::<Vec<f64>>();
-            let time = mean_ci(&pick(|f| f.row.time_s), LEVEL);
-            let rmse = mean_ci(&pick(|f| f.row.rmse), LEVEL);
-            let relmse = mean_ci(&pick(|f| f.row.relmse), LEVEL);
+            let pick = |f: &dyn Fn(&FinalRun) -> f64| g.iter().map(|r| f(r)).collect::<Vec<f64>>();
+            let time = mean_ci(&pick(&|f| f.row.time_s), LEVEL);
+            let rmse = mean_ci(&pick(&|f| f.row.rmse), LEVEL);
+            let mse_d = mean_ci(&pick(&|f| f.mse_debiased()), LEVEL);
+            let relmse = mean_ci(&pick(&|f| f.row.relmse), LEVEL);
+            let relmse_d = mean_ci(&pick(&|f| f.relmse_debiased()), LEVEL);
+            let slopes_t: Vec<f64> = g.iter().filter_map(|f| f.slope_time).collect();
+            let slopes_n: Vec<f64> = g.iter().filter_map(|f| f.slope_spp).collect();
+            let slope_t = (!slopes_t.is_empty()).then(|| mean_ci(&slopes_t, LEVEL));
             let floor = g[0].reference_noise_floor;
             let predicted: Vec<f64> = g
                 .iter()
@@ -90,62 +174,95 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
                     .iter()
                     .map(|f| f.row.time_s / budget_s - 1.0)
                     .fold(f64::NEG_INFINITY, f64::max),
-                spp_mean: mean_ci(&pick(|f| f.row.spp as f64), LEVEL).mean,
+                spp_mean: mean_ci(&pick(&|f| f.row.spp as f64), LEVEL).mean,
                 rmse_mean: rmse.mean,
                 rmse_ci95: rmse.half_width,
+                rmse_debiased: (mse_d.mean > 0.0).then(|| mse_d.mean.sqrt()),
+                mse_debiased_mean: mse_d.mean,
+                mse_debiased_ci95: mse_d.half_width,
                 relmse_mean: relmse.mean,
                 relmse_ci95: relmse.half_width,
+                relmse_debiased_mean: relmse_d.mean,
+                relmse_debiased_ci95: relmse_d.half_width,
                 efficiency: 1.0 / (relmse.mean * time.mean),
                 predicted_rmse: predicted.iter().sum::<f64>() / predicted.len() as f64,
                 reference_noise_floor: floor,
+                slope_time_mean: slope_t.as_ref().map(|m| m.mean),
+                slope_time_ci95: slope_t.and_then(|m| m.half_width),
+                slope_spp_mean: (!slopes_n.is_empty())
+                    .then(|| slopes_n.iter().sum::<f64>() / slopes_n.len() as f64),
                 welch_p_vs_best: None,
+                holm_p_vs_best: None,
                 vs_best: String::new(),
             }
         })
         .collect();
-    // Best = lowest mean relMSE per integrand; the others are tested against it.
-    for integrand in keys.iter().map(|k| k.0).collect::<Vec<_>>() {
+    let mut integrands: Vec<&str> = Vec::new();
+    for k in &keys {
+        if !integrands.contains(&k.0) {
+            integrands.push(k.0);
+        }
+    }
+    for &integrand in &integrands {
+        let mine: Vec<(&str, &str)> = keys.iter().copied().filter(|k| k.0 == integrand).collect();
+        // Best = lowest mean debiased relMSE.
         let Some(best) = rows
             .iter()
             .filter(|r| r.integrand == integrand)
-            .min_by(|a, b| a.relmse_mean.total_cmp(&b.relmse_mean))
+            .min_by(|a, b| a.relmse_debiased_mean.total_cmp(&b.relmse_debiased_mean))
             .map(|r| r.strategy.clone())
         else {
             continue;
         };
-        let best_relmse: Vec<f64> = group(&(integrand, best.as_str()))
-            .iter()
-            .map(|f| f.row.relmse)
-            .collect();
+        // The family: every pair of this integrand's strategies (Welch on per-run debiased
+        // relMSE), Holm-adjusted together; each row reports its pair with the best.
+        let mut pairs = Vec::new();
+        let mut raw = Vec::new();
+        for i in 0..mine.len() {
+            for j in i + 1..mine.len() {
+                if let Some(w) = welch_t_test(&debiased(&mine[i]), &debiased(&mine[j])) {
+                    pairs.push((mine[i].1, mine[j].1));
+                    raw.push(w.p_value);
+                }
+            }
+        }
+        let adjusted = holm_adjust(&raw);
         for r in rows.iter_mut().filter(|r| r.integrand == integrand) {
             if r.strategy == best {
                 r.vs_best = "best".into();
                 continue;
             }
-            let mine: Vec<f64> = group(&(integrand, r.strategy.as_str()))
-                .iter()
-                .map(|f| f.row.relmse)
-                .collect();
-            match welch_t_test(&mine, &best_relmse) {
-                Some(w) => {
-                    r.welch_p_vs_best = Some(w.p_value);
-                    r.vs_best = if w.p_value < 1.0 - LEVEL {
+            let pair = pairs.iter().position(|&(a, b)| {
+                (a == r.strategy && b == best) || (b == r.strategy && a == best)
+            });
+            match pair {
+                Some(k) => {
+                    r.welch_p_vs_best = Some(raw[k]);
+                    r.holm_p_vs_best = Some(adjusted[k]);
+                    r.vs_best = if adjusted[k] < 1.0 - LEVEL {
                         "worse"
                     } else {
                         "tie"
                     }
                     .into();
                 }
-                None => r.vs_best = "n/a".into(),
+                None => r.vs_best = "one run: no test".into(),
             }
         }
     }
+    // Sorted by the ranking metric within each integrand (stable: ties keep their order).
+    rows.sort_by(|a, b| {
+        let ia = integrands.iter().position(|&i| i == a.integrand);
+        let ib = integrands.iter().position(|&i| i == b.integrand);
+        ia.cmp(&ib)
+            .then(a.relmse_debiased_mean.total_cmp(&b.relmse_debiased_mean))
+    });
     rows
 }
 
-/// Warnings for integrands whose reference noise floor exceeds 10 % of the smallest RMSE
+/// Warnings for integrands whose reference noise floor exceeds `fraction` of the smallest RMSE
 /// compared: then the reference, not the strategies, limits what the ranking can resolve.
-pub fn noise_floor_warnings(rows: &[SummaryRow]) -> Vec<String> {
+pub fn noise_floor_warnings(rows: &[SummaryRow], fraction: f64) -> Vec<String> {
     let mut out = Vec::new();
     let mut seen: Vec<&str> = Vec::new();
     for r in rows {
@@ -159,7 +276,7 @@ pub fn noise_floor_warnings(rows: &[SummaryRow]) -> Vec<String> {
             .map(|x| x.rmse_mean)
             .fold(f64::INFINITY, f64::min);
         match r.reference_noise_floor {
-            Some(floor) if floor > 0.1 * min_rmse => out.push(format!(
+            Some(floor) if floor > fraction * min_rmse => out.push(format!(
                 "warning: {} reference noise floor {floor:.3e} is {:.0} % of the smallest RMSE \
                  compared ({min_rmse:.3e}); render a reference with more samples",
                 r.integrand,
@@ -198,6 +315,9 @@ mod tests {
             },
             mean_sample_variance: 0.01,
             reference_noise_floor: Some(0.001),
+            reference_relmse_floor: 0.0,
+            slope_time: None,
+            slope_spp: None,
         }
     }
 
@@ -221,6 +341,86 @@ mod tests {
         // predicted √(σ²·c/T + floor²) with σ² = 0.01, c = 0.01 s, T = 1 s.
         assert!((get("a").predicted_rmse - (1e-4f64 + 1e-6).sqrt()).abs() < 1e-12);
         assert!((get("a").efficiency - 1.0).abs() < 1e-12);
-        assert!(noise_floor_warnings(&rows).is_empty());
+        assert!(noise_floor_warnings(&rows, 0.1).is_empty());
+    }
+
+    /// A standard normal from a hashed key (Box–Muller).
+    fn normal(key: u64) -> f64 {
+        let u = |k: u64| ((crate::math::mix64(k) >> 11) as f64 + 0.5) / (1u64 << 53) as f64;
+        (-2.0 * u(key).ln()).sqrt() * (std::f64::consts::TAU * u(key ^ 0x9e37_79b9)).cos()
+    }
+
+    /// Under a true null (eight strategies with the same error distribution, five runs each)
+    /// the family-wise error rate of `worse` verdicts stays at most α = 5 % with Holm over all
+    /// pairs; the uncorrected p-value against the (selected) best exceeds it several-fold —
+    /// the negative control that shows the simulation can see a missing correction.
+    #[test]
+    fn holm_keeps_the_family_wise_error_rate_under_a_true_null() {
+        let (families, m, runs) = (1000u64, 8usize, 5u32);
+        let (mut holm_errors, mut raw_errors) = (0u32, 0u32);
+        for f in 0..families {
+            let mut finals = Vec::new();
+            for s in 0..m {
+                for k in 0..runs {
+                    let key = (f << 16) | ((s as u64) << 8) | k as u64;
+                    let name = format!("s{s}");
+                    finals.push(fr(&name, k, 1.0 + 0.1 * normal(key)));
+                }
+            }
+            let rows = summarize(&finals, 1.0);
+            holm_errors += rows.iter().any(|r| r.vs_best == "worse") as u32;
+            raw_errors += rows
+                .iter()
+                .any(|r| r.welch_p_vs_best.is_some_and(|p| p < 1.0 - LEVEL))
+                as u32;
+        }
+        let (holm, raw) = (
+            holm_errors as f64 / families as f64,
+            raw_errors as f64 / families as f64,
+        );
+        eprintln!("family-wise error rate: Holm {holm}, uncorrected {raw}");
+        // 3σ of a binomial rate 0.05 over 1000 families: 0.021.
+        assert!(holm <= 0.05 + 0.021, "Holm FWER {holm}");
+        assert!(raw > 0.15, "uncorrected FWER {raw}: the simulation cannot see the correction");
+    }
+
+    /// A run whose RMSE falls as c·t^(-1/2) and c·n^(-1/2) has slopes −½ exactly; one with a
+    /// floor (a biased or correlated estimator) is flatter.
+    #[test]
+    fn convergence_slopes_of_a_clean_and_a_flattening_run() {
+        let rows = |floor: f64| -> Vec<ResultRow> {
+            (0..8)
+                .map(|k| {
+                    let spp = 4u64 << k;
+                    let mut r = fr("a", 0, 1.0).row;
+                    r.spp = spp;
+                    r.time_s = 0.01 * spp as f64;
+                    r.rmse = (1.0 / spp as f64 + floor * floor).sqrt();
+                    r
+                })
+                .collect()
+        };
+        let (t, n) = convergence_slopes(&rows(0.0));
+        assert!((t.unwrap() + 0.5).abs() < 1e-12 && (n.unwrap() + 0.5).abs() < 1e-12);
+        let (t, _) = convergence_slopes(&rows(0.05));
+        assert!(t.unwrap() > -0.45, "{t:?}");
+        assert_eq!(convergence_slopes(&rows(0.0)[..2]), (None, None));
+    }
+
+    /// Debiased MSE subtracts floor²; debiased relMSE the reference's relMSE floor; the ranking
+    /// and the verdicts use the debiased relMSE.
+    #[test]
+    fn debiased_errors_subtract_the_floors() {
+        let mut a = fr("a", 0, 0.04);
+        a.reference_relmse_floor = 0.01;
+        assert!((a.mse_debiased() - (0.04 - 1e-6)).abs() < 1e-15);
+        assert!((a.relmse_debiased() - 0.03).abs() < 1e-15);
+        let rows = summarize(&[a.clone()], 1.0);
+        assert!((rows[0].relmse_debiased_mean - 0.03).abs() < 1e-15);
+        assert_eq!(rows[0].vs_best, "best");
+        let b = fr("b", 0, 0.02);
+        let rows = summarize(&[a, b], 1.0);
+        assert_eq!(rows[0].strategy, "b", "sorted by the ranking metric");
+        assert_eq!(rows[1].vs_best, "one run: no test");
     }
 }
