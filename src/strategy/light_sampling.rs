@@ -81,16 +81,13 @@ pub struct BoundLights<'s> {
 
 impl<'s> BoundLights<'s> {
     /// `methods` as the scene can use them, in the view's environment representation; Err
-    /// when the selector cannot select (no light with positive power).
+    /// when the selector cannot select (no light with positive power, too many lights).
     pub fn bind(
         scene: &SceneView<'s>,
         selector: &'static SelectorType,
         methods: LightMethods,
     ) -> Result<Self, String> {
-        let selector = scene
-            .lights
-            .selector(selector)
-            .ok_or_else(|| "no light with positive power".to_string())?;
+        let selector = scene.lights.selector(selector)?;
         Ok(BoundLights {
             lights: scene.lights,
             selector,
