@@ -98,11 +98,12 @@ impl LightBounds {
     }
 }
 
-/// A cone of directions in f64 for building: unit axis and half-angle.
+/// A cone of directions in f64 for building: unit axis, half-angle and its cosine.
 #[derive(Clone, Copy, Debug)]
 pub struct Cone {
     pub axis: DVec3,
     pub theta: f64,
+    pub cos: f64,
 }
 
 /// The angle between two unit vectors, accurate near 0 and π.
@@ -112,9 +113,15 @@ pub fn angle_between(a: DVec3, b: DVec3) -> f64 {
 
 impl Cone {
     pub fn new(axis: Vec3, theta: f32) -> Self {
+        Self::of(axis.as_dvec3().normalize(), theta as f64)
+    }
+
+    /// About a unit axis.
+    pub fn of(axis: DVec3, theta: f64) -> Self {
         Cone {
-            axis: axis.as_dvec3().normalize(),
-            theta: theta as f64,
+            axis,
+            theta,
+            cos: theta.cos(),
         }
     }
 
@@ -123,10 +130,11 @@ impl Cone {
     /// from a's towards b's by that minus θa.
     pub fn union(self, b: Cone) -> Cone {
         if self.theta >= PI || b.theta >= PI {
-            return Cone {
-                axis: self.axis,
-                theta: PI,
-            };
+            return Cone::of(self.axis, PI);
+        }
+        // The common case while building: one more normal inside the cone (no atan2).
+        if b.theta == 0.0 && self.axis.dot(b.axis) >= self.cos {
+            return self;
         }
         let d = angle_between(self.axis, b.axis);
         if d + b.theta <= self.theta {
@@ -137,10 +145,7 @@ impl Cone {
         }
         let theta = 0.5 * (self.theta + d + b.theta);
         if theta >= PI {
-            return Cone {
-                axis: self.axis,
-                theta: PI,
-            };
+            return Cone::of(self.axis, PI);
         }
         // Rotate a's axis by theta − θa in the plane of both axes (d > 0 here: with d = 0 one
         // cone holds the other). Antiparallel axes (d = π) give θ ≥ π above.
@@ -148,15 +153,10 @@ impl Cone {
         let perp = (b.axis - self.axis * self.axis.dot(b.axis)).normalize_or_zero();
         if perp == DVec3::ZERO {
             // Axes equal to f64 rounding, d tiny: widen a's cone to hold b.
-            return Cone {
-                axis: self.axis,
-                theta: self.theta.max(d + b.theta),
-            };
+            return Cone::of(self.axis, self.theta.max(d + b.theta));
         }
-        Cone {
-            axis: (self.axis * rot.cos() + perp * rot.sin()).normalize(),
-            theta,
-        }
+        let (s, c) = rot.sin_cos();
+        Cone::of((self.axis * c + perp * s).normalize(), theta)
     }
 
     /// Contains direction-cone `b`, with the same padding the importance uses.
@@ -169,6 +169,13 @@ impl Cone {
 /// over directions of the cosine-falloff emission profile, 2π∫₀^θo sin θ dθ +
 /// 2π∫_θo^θw cos(θ − θo) sin θ dθ with θw = min(θo + θe, π).
 pub fn orientation_measure(theta_o: f64, theta_e: f64) -> f64 {
+    // The two cases most clusters are in: normals anywhere (4π), or one flat direction (π).
+    if theta_o >= PI {
+        return 4.0 * PI;
+    }
+    if theta_o == 0.0 && (theta_e - 0.5 * PI).abs() < 1e-7 {
+        return PI;
+    }
     let theta_w = (theta_o + theta_e).min(PI);
     let (so, co) = theta_o.sin_cos();
     2.0 * PI * (1.0 - co)
@@ -387,10 +394,7 @@ impl Default for BoundsSum {
         BoundsSum {
             lo: Vec3::INFINITY,
             hi: Vec3::NEG_INFINITY,
-            cone: Cone {
-                axis: DVec3::Z,
-                theta: 0.0,
-            },
+            cone: Cone::of(DVec3::Z, 0.0),
             theta_e: 0.0,
             intensity: 0.0,
             count: 0,
@@ -399,6 +403,13 @@ impl Default for BoundsSum {
 }
 
 impl BoundsSum {
+    /// One light's bounds as a sum.
+    pub fn of(b: &LightBounds) -> Self {
+        let mut s = BoundsSum::default();
+        s.add(b);
+        s
+    }
+
     pub fn add(&mut self, b: &LightBounds) {
         let cone = Cone::new(b.axis, b.theta_o);
         self.cone = if self.count == 0 {
@@ -495,14 +506,8 @@ mod tests {
                 .normalize()
         };
         for k in 0..2000 {
-            let a = Cone {
-                axis: dir(),
-                theta: (k % 7) as f64 * 0.3,
-            };
-            let b = Cone {
-                axis: dir(),
-                theta: (k % 5) as f64 * 0.2,
-            };
+            let a = Cone::of(dir(), (k % 7) as f64 * 0.3);
+            let b = Cone::of(dir(), (k % 5) as f64 * 0.2);
             let u = a.union(b);
             for c in [a, b] {
                 assert!(
@@ -511,14 +516,8 @@ mod tests {
                 );
             }
         }
-        let wide = Cone {
-            axis: DVec3::Z,
-            theta: 1.0,
-        };
-        let narrow = Cone {
-            axis: DVec3::new(0.0, 0.1f64.sin(), 0.1f64.cos()),
-            theta: 0.2,
-        };
+        let wide = Cone::of(DVec3::Z, 1.0);
+        let narrow = Cone::of(DVec3::new(0.0, 0.1f64.sin(), 0.1f64.cos()), 0.2);
         assert_eq!(wide.union(narrow).theta, 1.0);
         assert_eq!(narrow.union(wide).theta, 1.0);
     }

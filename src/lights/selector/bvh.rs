@@ -20,8 +20,7 @@
 
 use super::{LightSelector, SelectorType, remap};
 use crate::lights::bounds::{
-    Bounds, BoundsSum, CompactBounds, DistantBounds, ImportanceModel, LightBounds,
-    orientation_measure,
+    Bounds, BoundsSum, CompactBounds, DistantBounds, ImportanceModel, orientation_measure,
 };
 use crate::lights::{Light, LightCtx};
 use glam::Vec3;
@@ -101,7 +100,8 @@ pub struct LightBvh {
 
 struct Item {
     light: u32,
-    bounds: LightBounds,
+    /// The light's own bounds, as a sum of one (its cone ready for unions).
+    bounds: BoundsSum,
     centroid: Vec3,
 }
 
@@ -110,8 +110,8 @@ struct Task {
     end: usize,
     sum: BoundsSum,
     depth: usize,
-    /// The interior node whose right child this is.
-    right_of: Option<usize>,
+    /// Its node's index in the slice being built.
+    at: usize,
 }
 
 impl LightBvh {
@@ -133,7 +133,7 @@ impl LightBvh {
                 Bounds::Local(b) if b.intensity > 0.0 => items.push(Item {
                     light: i as u32,
                     centroid: b.centroid(),
-                    bounds: b,
+                    bounds: BoundsSum::of(&b),
                 }),
                 Bounds::Distant(d) if d.irradiance > 0.0 => {
                     distant_of[i] = distant.len() as u32;
@@ -228,7 +228,7 @@ impl LightBvh {
     /// of that path at `ctx`, the root's top-level share included; stops at the first leaf.
     pub fn path_pmf(&self, ctx: &LightCtx, path: impl IntoIterator<Item = bool>) -> (usize, f32) {
         let (root, distant) = self.top(ctx);
-        let mut pmf = root / (root + distant);
+        let mut pmf = if root > 0.0 { root / (root + distant) } else { 0.0 };
         let mut k = 0;
         let mut path = path.into_iter();
         loop {
@@ -350,60 +350,99 @@ fn cost(s: &BoundsSum) -> f64 {
     s.intensity * orientation_measure(s.cone.theta, s.theta_e) * s.area_measure()
 }
 
-/// The nodes, depth first, and the tree's depth; fills `leaf_of`.
+/// Ranges at least this large split on two threads (rayon), above depth 32 never.
+const PARALLEL_MIN: usize = 1 << 15;
+
+/// The nodes, depth first, and the tree's depth; fills `leaf_of`. A subtree over m lights
+/// takes exactly 2m − 1 nodes, so every subtree's place is known before it is built: the two
+/// halves of a split are built into disjoint slices, in parallel for large ones, and the
+/// result does not depend on the thread schedule.
 fn build_nodes(items: &mut [Item], leaf_of: &mut [u32]) -> (Vec<Node>, usize) {
-    let mut nodes: Vec<Node> = Vec::with_capacity((2 * items.len()).saturating_sub(1));
     if items.is_empty() {
-        return (nodes, 0);
+        return (Vec::new(), 0);
     }
     let mut root = BoundsSum::default();
     for it in items.iter() {
-        root.add(&it.bounds);
+        root.merge(&it.bounds);
     }
+    let blank = Node {
+        bounds: CompactBounds::new(&root.bounds()),
+        child: 0,
+    };
+    let mut nodes = vec![blank; 2 * items.len() - 1];
+    let depth = build_into(&mut nodes, 0, items, root, 0);
+    for (k, n) in nodes.iter().enumerate() {
+        if let Some(light) = n.leaf_light() {
+            leaf_of[light] = k as u32;
+        }
+    }
+    (nodes, depth)
+}
+
+/// The subtree over `items` with bounds `sum` into `nodes` (2·len − 1 of them; the first is
+/// node `base` of the tree), at depth `depth`; returns the deepest leaf's depth.
+fn build_into(
+    nodes: &mut [Node],
+    base: usize,
+    items: &mut [Item],
+    sum: BoundsSum,
+    depth: usize,
+) -> usize {
+    if items.len() >= PARALLEL_MIN && depth < 32 {
+        let (mid, left, right) = split(items, &sum);
+        let (head, rest) = nodes.split_first_mut().expect("2·len − 1 > 0 nodes");
+        *head = Node {
+            bounds: CompactBounds::new(&sum.bounds()),
+            child: (base + 2 * mid) as u32,
+        };
+        let (ln, rn) = rest.split_at_mut(2 * mid - 1);
+        let (li, ri) = items.split_at_mut(mid);
+        let (a, b) = rayon::join(
+            || build_into(ln, base + 1, li, left, depth + 1),
+            || build_into(rn, base + 2 * mid, ri, right, depth + 1),
+        );
+        return a.max(b);
+    }
+    // Below: one thread, an explicit stack (no recursion however deep the tree gets).
     let mut stack = vec![Task {
         start: 0,
         end: items.len(),
-        sum: root,
-        depth: 0,
-        right_of: None,
+        sum,
+        depth,
+        at: 0,
     }];
-    let mut max_depth = 0;
+    let mut max_depth = depth;
     while let Some(t) = stack.pop() {
-        let k = nodes.len();
-        if let Some(parent) = t.right_of {
-            nodes[parent].child = k as u32;
-        }
         max_depth = max_depth.max(t.depth);
         if t.end - t.start == 1 {
             let it = &items[t.start];
-            leaf_of[it.light as usize] = k as u32;
-            nodes.push(Node {
-                bounds: CompactBounds::new(&it.bounds),
+            nodes[t.at] = Node {
+                bounds: CompactBounds::new(&it.bounds.bounds()),
                 child: LEAF | it.light,
-            });
+            };
             continue;
         }
-        nodes.push(Node {
-            bounds: CompactBounds::new(&t.sum.bounds()),
-            child: 0,
-        });
         let (mid, left, right) = split(&mut items[t.start..t.end], &t.sum);
+        nodes[t.at] = Node {
+            bounds: CompactBounds::new(&t.sum.bounds()),
+            child: (base + t.at + 2 * mid) as u32,
+        };
         stack.push(Task {
             start: t.start + mid,
             end: t.end,
             sum: right,
             depth: t.depth + 1,
-            right_of: Some(k),
+            at: t.at + 2 * mid,
         });
         stack.push(Task {
             start: t.start,
             end: t.start + mid,
             sum: left,
             depth: t.depth + 1,
-            right_of: None,
+            at: t.at + 1,
         });
     }
-    (nodes, max_depth)
+    max_depth
 }
 
 /// Partitions `items` (at least two) at the cheapest of the 11 bucket boundaries on each axis
@@ -424,7 +463,7 @@ fn split(items: &mut [Item], sum: &BoundsSum) -> (usize, BoundsSum, BoundsSum) {
         }
         let mut buckets = [BoundsSum::default(); BUCKETS];
         for it in items.iter() {
-            buckets[bucket(it.centroid[dim], clo[dim], extent)].add(&it.bounds);
+            buckets[bucket(it.centroid[dim], clo[dim], extent)].merge(&it.bounds);
         }
         let mut below = [BoundsSum::default(); BUCKETS - 1];
         let mut acc = BoundsSum::default();
@@ -437,7 +476,8 @@ fn split(items: &mut [Item], sum: &BoundsSum) -> (usize, BoundsSum, BoundsSum) {
         let mut above = BoundsSum::default();
         for i in (0..BUCKETS - 1).rev() {
             above.merge(&buckets[i + 1]);
-            if below[i].count == 0 || above.count == 0 {
+            // After an empty bucket the partition is the previous boundary's.
+            if below[i].count == 0 || above.count == 0 || buckets[i].count == 0 {
                 continue;
             }
             let c = kr * (cost(&below[i]) + cost(&above));
@@ -451,10 +491,10 @@ fn split(items: &mut [Item], sum: &BoundsSum) -> (usize, BoundsSum, BoundsSum) {
         let mut left = BoundsSum::default();
         let mut right = BoundsSum::default();
         for it in &items[..mid] {
-            left.add(&it.bounds);
+            left.merge(&it.bounds);
         }
         for it in &items[mid..] {
-            right.add(&it.bounds);
+            right.merge(&it.bounds);
         }
         return (mid, left, right);
     };
