@@ -175,6 +175,10 @@ impl Strategy for LightSampling {
         match (self.env, self.method) {
             (Some(_), _) => "as `light`, but the environment looked up and sampled in this representation by this sampler (cdf: marginal/conditional, hier: hierarchical warping)".into(),
             (None, Some(o)) => format!("as `light`, but {}", o.describe()),
+            (None, None) if self.selector != default_selector() => format!(
+                "as `light`, but the light chosen by the `{}` selector: {}",
+                self.selector.name, self.selector.describe
+            ),
             (None, None) => "power-proportional light choice; quad/mesh: uniform area, sphere: uniform cone, point/spot/directional: exact".into(),
         }
     }
