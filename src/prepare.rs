@@ -10,7 +10,7 @@ use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
 use crate::lights::directional::DirectionalLight;
 use crate::lights::environment::EnvironmentLight;
-use crate::lights::mesh::MeshLight;
+use crate::lights::mesh::TriangleLight;
 use crate::lights::point::PointLight;
 use crate::lights::quad::QuadLight;
 use crate::lights::sphere::SphereLight;
@@ -141,17 +141,16 @@ impl PreparedScene {
                     )
                 })
                 .collect();
-            let light = mesh
-                .emission
-                .and_then(|l| MeshLight::new(tris.clone(), l))
-                .map(|m| add(&mut lights, Box::new(m)));
-            for (k, t) in tris.into_iter().enumerate() {
+            // One light per emitting triangle, so that a selector can weigh each on its own
+            // (triangles without area cannot emit and get none).
+            for t in tris {
+                let light = mesh
+                    .emission
+                    .and_then(|l| TriangleLight::new(t, l))
+                    .map(|l| add(&mut lights, Box::new(l)));
                 g.triangles.push(t);
                 prim_material.push(mesh.material);
-                prim_emitter.push(light.map(|light| EmitterRef {
-                    light,
-                    local: k as u32,
-                }));
+                prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
             }
         }
         for q in &scene.quads {
@@ -267,7 +266,8 @@ impl PreparedScene {
     ) -> Option<(usize, crate::lights::LightSample)> {
         let sel = self
             .lights
-            .selector(crate::lights::selector::default_selector())?;
+            .selector(crate::lights::selector::default_selector())
+            .ok()?;
         let ctx = crate::lights::LightCtx { p, n: Vec3::ZERO };
         self.lights.sample(sel, &ctx, u_select, u, methods)
     }

@@ -1,6 +1,7 @@
 //! Directional (distant) light: irradiance E⊥ arriving along one direction, E = E⊥·cos θ.
 //! Its shadow ray is unbounded.
 
+use super::bounds::{Bounds, DistantBounds};
 use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape};
 use crate::math::luminance;
 use glam::Vec3;
@@ -35,6 +36,13 @@ impl Light for DirectionalLight {
 
     fn power(&self) -> f32 {
         std::f32::consts::PI * self.scene_radius * self.scene_radius * luminance(self.irradiance)
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds::Distant(DistantBounds {
+            to_light: Some(self.to_light),
+            irradiance: luminance(self.irradiance),
+        })
     }
 
     fn sample(&self, _ctx: &LightCtx, _u: [f32; 3], _m: &LightMethods) -> Option<LightSample> {

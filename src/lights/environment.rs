@@ -2,6 +2,7 @@
 //! the representation and by the sampler a strategy's `LightMethods::env` names
 //! (`crate::env`). Like a directional light it is distant: its shadow rays are unbounded.
 
+use super::bounds::{Bounds, DistantBounds};
 use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape};
 use crate::env::{EnvMethod, Environment, Repr};
 use glam::Vec3;
@@ -42,6 +43,13 @@ impl Light for EnvironmentLight {
     fn power(&self) -> f32 {
         let r = self.scene_radius as f64;
         (std::f64::consts::PI * r * r * self.env.map(Repr::LatLong).luminance_integral) as f32
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds::Distant(DistantBounds {
+            to_light: None,
+            irradiance: self.env.map(Repr::LatLong).luminance_integral as f32,
+        })
     }
 
     fn sample(&self, _ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {

@@ -1,61 +1,58 @@
-//! Emissive triangle mesh, emitting on front faces (counter-clockwise winding).
-//! Area sampling: a triangle chosen with probability A_i/A, then a uniform point on it, so the
-//! area pdf is 1/A over the whole mesh; converted to solid angle by d²/|cos θ_l|.
+//! Emissive triangle meshes, one light per triangle, emitting on front faces (counter-clockwise
+//! winding). The selector picks the triangle, so a light BVH can weigh every triangle by its
+//! own distance, orientation and radiance (Conty Estevez & Kulla 2018 build their tree over
+//! triangles for the same reason). Under power selection a mesh of one radiance is sampled
+//! exactly as when it was one light choosing triangle i with probability A_i/A: the power
+//! pmf of triangle i is P_mesh/P·A_i/A, the product the former sampler had.
+//! Area sampling: a uniform point, pdf_A = 1/A_i, converted to solid angle by d²/|cos θ_l|.
+//! Solid-angle sampling: uniform on the spherical triangle (Arvo 1995), pdf 1/Ω_i.
 
+use super::bounds::{Bounds, LightBounds};
 use super::{
     Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, MeshMethod, direction_to,
 };
 use crate::geometry::triangle::Triangle;
 use crate::math::gamma;
 use crate::math::luminance;
-use crate::sampling::discrete::DiscreteDistribution;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalTriangle, triangle_solid_angle};
 use crate::sampling::warp::sample_uniform_triangle;
 use glam::Vec3;
 
-#[derive(Clone, Debug)]
-pub struct MeshLight {
-    pub triangles: Vec<Triangle>,
-    /// Unit normals; zero for degenerate triangles, which are never sampled (weight 0).
-    pub normals: Vec<Vec3>,
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleLight {
+    pub triangle: Triangle,
+    /// Unit normal of the emitting (front) face.
+    pub normal: Vec3,
     pub area: f32,
-    pub by_area: DiscreteDistribution,
     pub radiance: Vec3,
 }
 
-impl MeshLight {
-    /// None when the mesh has no area at all.
-    pub fn new(triangles: Vec<Triangle>, radiance: Vec3) -> Option<Self> {
-        let areas: Vec<f32> = triangles.iter().map(Triangle::area).collect();
-        let by_area = DiscreteDistribution::new(&areas)?;
-        let normals = triangles
-            .iter()
-            .map(|t| t.cross().normalize_or_zero())
-            .collect();
-        Some(MeshLight {
-            area: by_area.total() as f32,
-            triangles,
-            normals,
-            by_area,
+impl TriangleLight {
+    /// None for a triangle without area (collinear or repeated vertices): it cannot emit.
+    pub fn new(triangle: Triangle, radiance: Vec3) -> Option<Self> {
+        let c = triangle.cross();
+        let area = 0.5 * c.length();
+        let normal = c.normalize_or_zero();
+        (area > 0.0 && normal != Vec3::ZERO).then_some(TriangleLight {
+            triangle,
+            normal,
+            area,
             radiance,
         })
     }
 
-    /// u[2] picks the triangle (a fresh dimension, not a rescaled one: with 1e8 area ratios a
-    /// rescaled u would have no resolution left), u[0..2] the point on it.
-    pub fn sample_area(&self, p: Vec3, u: [f32; 3]) -> Option<LightSample> {
-        let i = self.by_area.sample(u[2]);
-        let (q, q_error) = self.triangles[i].point_uniform([u[0], u[1]]);
-        let n = self.normals[i];
+    /// A uniform point on the triangle. None when p sees its back or lies in its plane.
+    pub fn sample_area(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        let (q, q_error) = self.triangle.point_uniform(u);
         let (wi, d2) = direction_to(p, q)?;
-        let cos_l = -n.dot(wi);
+        let cos_l = -self.normal.dot(wi);
         if cos_l <= 0.0 {
             return None;
         }
         Some(LightSample {
             wi,
             point: q,
-            normal: n,
+            normal: self.normal,
             point_error: q_error,
             radiance: self.radiance,
             pdf: d2 / (self.area * cos_l),
@@ -63,15 +60,73 @@ impl MeshLight {
         })
     }
 
-    /// Solid-angle pdf of [`Self::sample_area`] for the direction reaching point q on triangle i.
-    pub fn pdf_area(&self, p: Vec3, q: Vec3, i: usize) -> f32 {
+    /// Solid-angle pdf of [`Self::sample_area`] for the direction reaching light point q.
+    pub fn pdf_area(&self, p: Vec3, q: Vec3) -> f32 {
         let d = q - p;
         let d2 = d.length_squared();
-        let cos_l = -self.normals[i].dot(d) / d2.sqrt();
+        let cos_l = -self.normal.dot(d) / d2.sqrt();
         if cos_l > 0.0 {
             d2 / (self.area * cos_l)
         } else {
             0.0
+        }
+    }
+
+    /// The triangle as a spherical triangle seen from p, when it is large enough for f64
+    /// solid-angle sampling.
+    fn spherical_triangle(&self, p: Vec3) -> Option<SphericalTriangle> {
+        let t = &self.triangle;
+        let (a, b, c) = (
+            (t.v0 - p).as_dvec3().normalize(),
+            (t.v1 - p).as_dvec3().normalize(),
+            (t.v2 - p).as_dvec3().normalize(),
+        );
+        if triangle_solid_angle(a, b, c) < MIN_SOLID_ANGLE {
+            return None;
+        }
+        SphericalTriangle::new(a, b, c)
+    }
+
+    fn faces(&self, p: Vec3) -> bool {
+        (p - self.triangle.v0).dot(self.normal) > 0.0
+    }
+
+    /// Uniform in the triangle's solid angle (Arvo 1995): pdf 1/Ω. Triangles too small in
+    /// solid angle are sampled by area instead; the pdf follows suit.
+    pub fn sample_solid_angle(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
+        if !self.faces(p) {
+            return None;
+        }
+        let Some(st) = self.spherical_triangle(p) else {
+            return self.sample_area(p, u);
+        };
+        let w = st.sample([u[0] as f64, u[1] as f64]);
+        // Where the direction meets the triangle's plane.
+        let n = self.normal.as_dvec3();
+        let cos = w.dot(n);
+        if cos >= 0.0 {
+            return None; // grazing the plane: measure zero for a front-facing triangle
+        }
+        let dist = (self.triangle.v0 - p).as_dvec3().dot(n) / cos;
+        let point = p + (w * dist).as_vec3();
+        Some(LightSample {
+            wi: w.as_vec3(),
+            point,
+            normal: self.normal,
+            point_error: gamma(3) * (p.abs() + (w * dist).as_vec3().abs()),
+            radiance: self.radiance,
+            pdf: (1.0 / st.area()) as f32,
+            distant: false,
+        })
+    }
+
+    pub fn pdf_solid_angle(&self, p: Vec3, q: Vec3) -> f32 {
+        if !self.faces(p) {
+            return 0.0;
+        }
+        match self.spherical_triangle(p) {
+            Some(st) => (1.0 / st.area()) as f32,
+            None => self.pdf_area(p, q),
         }
     }
 }
@@ -84,71 +139,7 @@ impl Triangle {
     }
 }
 
-impl MeshLight {
-    /// Triangle i as a spherical triangle seen from p, when p sees its front and it is large
-    /// enough for f64 solid-angle sampling.
-    fn spherical_triangle(&self, p: Vec3, i: usize) -> Option<SphericalTriangle> {
-        let t = &self.triangles[i];
-        let (a, b, c) = (
-            (t.v0 - p).as_dvec3(),
-            (t.v1 - p).as_dvec3(),
-            (t.v2 - p).as_dvec3(),
-        );
-        let (a, b, c) = (a.normalize(), b.normalize(), c.normalize());
-        if triangle_solid_angle(a, b, c) < MIN_SOLID_ANGLE {
-            return None;
-        }
-        SphericalTriangle::new(a, b, c)
-    }
-
-    fn faces(&self, p: Vec3, i: usize) -> bool {
-        (p - self.triangles[i].v0).dot(self.normals[i]) > 0.0
-    }
-
-    /// Triangle by area (u[2]), then uniform in its solid angle (Arvo 1995): pdf pmf_i/Ω_i.
-    /// Triangles too small in solid angle are sampled by area instead; the pdf follows suit.
-    pub fn sample_solid_angle(&self, p: Vec3, u: [f32; 3]) -> Option<LightSample> {
-        let i = self.by_area.sample(u[2]);
-        if !self.faces(p, i) {
-            return None;
-        }
-        let Some(st) = self.spherical_triangle(p, i) else {
-            return self.sample_area(p, u);
-        };
-        let w = st.sample([u[0] as f64, u[1] as f64]);
-        // Where the direction meets the triangle's plane.
-        let t = &self.triangles[i];
-        let n = self.normals[i].as_dvec3();
-        let cos = w.dot(n);
-        if cos >= 0.0 {
-            return None; // grazing the plane: measure zero for a front-facing triangle
-        }
-        let dist = (t.v0 - p).as_dvec3().dot(n) / cos;
-        let point = p + (w * dist).as_vec3();
-        let pdf = (self.by_area.pmf(i) as f64 / st.area()) as f32;
-        Some(LightSample {
-            wi: w.as_vec3(),
-            point,
-            normal: self.normals[i],
-            point_error: gamma(3) * (p.abs() + (w * dist).as_vec3().abs()),
-            radiance: self.radiance,
-            pdf,
-            distant: false,
-        })
-    }
-
-    pub fn pdf_solid_angle(&self, p: Vec3, q: Vec3, i: usize) -> f32 {
-        if !self.faces(p, i) {
-            return 0.0;
-        }
-        match self.spherical_triangle(p, i) {
-            Some(st) => (self.by_area.pmf(i) as f64 / st.area()) as f32,
-            None => self.pdf_area(p, q, i),
-        }
-    }
-}
-
-impl Light for MeshLight {
+impl Light for TriangleLight {
     fn shape(&self) -> LightShape {
         LightShape::Mesh
     }
@@ -157,7 +148,18 @@ impl Light for MeshLight {
         std::f32::consts::PI * self.area * luminance(self.radiance)
     }
 
+    fn bounds(&self) -> Bounds {
+        let t = &self.triangle;
+        Bounds::Local(LightBounds::flat(
+            &[t.v0, t.v1, t.v2],
+            self.normal,
+            luminance(self.radiance),
+            self.area,
+        ))
+    }
+
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
+        let u = [u[0], u[1]];
         match m.mesh {
             MeshMethod::Area => self.sample_area(ctx.p, u),
             MeshMethod::SolidAngle => self.sample_solid_angle(ctx.p, u),
@@ -165,12 +167,12 @@ impl Light for MeshLight {
     }
 
     fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {
-        let LightHit::Surface { q, local } = at else {
+        let LightHit::Surface { q, .. } = at else {
             return 0.0;
         };
         match m.mesh {
-            MeshMethod::Area => self.pdf_area(ctx.p, q, local as usize),
-            MeshMethod::SolidAngle => self.pdf_solid_angle(ctx.p, q, local as usize),
+            MeshMethod::Area => self.pdf_area(ctx.p, q),
+            MeshMethod::SolidAngle => self.pdf_solid_angle(ctx.p, q),
         }
     }
 
@@ -185,7 +187,8 @@ impl Light for MeshLight {
 }
 
 /// χ² cases: four coplanar triangles of unequal area facing down onto the origin from
-/// `height`, sampled by each method.
+/// `height`, one triangle picked by the power selector (∝ area here), then sampled by each
+/// method: the whole distribution a mesh light's sample has.
 pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
     MeshMethod::ALL
         .into_iter()
@@ -197,9 +200,9 @@ pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
             crate::chi2::WarpEntry::new(
                 name,
                 match method {
-                    MeshMethod::Area => "mesh light, triangle by area then uniform by area",
+                    MeshMethod::Area => "mesh light, triangle by power then uniform by area",
                     MeshMethod::SolidAngle => {
-                        "mesh light, triangle by area then spherical triangle (Arvo 1995)"
+                        "mesh light, triangle by power then spherical triangle (Arvo 1995)"
                     }
                 },
                 &[("height", 1.2)],
@@ -208,6 +211,48 @@ pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
             )
         })
         .collect()
+}
+
+/// Triangles behind the power selector as one light, for the χ² adapter: u[2] selects.
+#[derive(Debug)]
+struct PowerSelected {
+    triangles: Vec<TriangleLight>,
+    table: crate::sampling::discrete::AliasTable,
+}
+
+impl Light for PowerSelected {
+    fn shape(&self) -> LightShape {
+        LightShape::Mesh
+    }
+
+    fn power(&self) -> f32 {
+        self.triangles.iter().map(|t| t.power()).sum()
+    }
+
+    fn bounds(&self) -> Bounds {
+        let mut sum = super::bounds::BoundsSum::default();
+        for t in &self.triangles {
+            if let Bounds::Local(b) = t.bounds() {
+                sum.add(&b);
+            }
+        }
+        Bounds::Local(sum.bounds())
+    }
+
+    fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
+        let i = self.table.sample(u[2] as f64);
+        let mut s = self.triangles[i].sample(ctx, u, m)?;
+        s.pdf *= self.table.pmf(i);
+        Some(s)
+    }
+
+    fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {
+        let LightHit::Surface { local, .. } = at else {
+            return 0.0;
+        };
+        let i = local as usize;
+        self.table.pmf(i) * self.triangles[i].pdf(ctx, at, m)
+    }
 }
 
 fn chi2_case(
@@ -234,7 +279,12 @@ fn chi2_case(
         .map(|f| Triangle::new(v[f[0]], v[f[1]], v[f[2]]))
         .collect();
     debug_assert!(tris.iter().all(|t| t.cross().z < 0.0));
-    let light = MeshLight::new(tris.clone(), Vec3::ONE).ok_or("degenerate mesh")?;
+    let triangles: Vec<TriangleLight> = tris
+        .iter()
+        .map(|&t| TriangleLight::new(t, Vec3::ONE).ok_or("degenerate triangle"))
+        .collect::<Result<_, _>>()?;
+    let powers: Vec<f32> = triangles.iter().map(|t| t.power()).collect();
+    let table = crate::sampling::discrete::AliasTable::new(&powers).ok_or("no power")?;
     let chart = cap_around(Vec3::new(0.0, 0.0, h), &v);
     let methods = LightMethods {
         mesh: method,
@@ -242,7 +292,7 @@ fn chi2_case(
     };
     Ok(light_case(
         label(name, p),
-        light,
+        PowerSelected { triangles, table },
         methods,
         move |w| first_hit(&tris, w),
         chart,

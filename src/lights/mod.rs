@@ -4,6 +4,7 @@
 //! sampler returns its pdf in solid angle at the shading point, the measure of the
 //! direct-illumination integral, or reports a delta light.
 
+pub mod bounds;
 pub mod directional;
 pub mod environment;
 pub mod mesh;
@@ -16,6 +17,7 @@ pub mod spot;
 use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
+use bounds::Bounds;
 use glam::Vec3;
 use selector::{LightSelector, SELECTORS, SelectorType};
 use std::sync::{Arc, OnceLock};
@@ -266,7 +268,9 @@ impl LightSample {
 
 /// What a light knows of the point it is sampled from: the position and the shading normal
 /// (flipped to the viewer's side), as pbrt-v4's `LightSampleContext`. Selectors that weigh
-/// lights by orientation use the normal; every light sampler uses `p`.
+/// lights by orientation use the normal: dibench's surfaces reflect into the hemisphere about
+/// it only, so a light wholly below it provably adds nothing; zero means no orientation (a
+/// point that receives from every direction). Every light sampler uses `p`.
 #[derive(Clone, Copy, Debug)]
 pub struct LightCtx {
     pub p: Vec3,
@@ -326,9 +330,14 @@ pub trait Light: Send + Sync + std::fmt::Debug {
         self.shape().is_delta()
     }
 
+    /// What light selection knows of this light: its bounds if it is at a finite place, its
+    /// irradiance if it is at infinity (see [`bounds`]).
+    fn bounds(&self) -> Bounds;
+
     /// A sample of this light seen from `ctx`, by the method `m` selects for its shape.
-    /// u[0..2] place the sample, u[2] is a third number for lights with parts (a mesh's
-    /// triangle); None when the sample carries no light (the back of a one-sided emitter).
+    /// u[0..2] place the sample; u[2] is not the light's (a [`LightSet`] spends it on the low
+    /// bits of the selection number); None when the sample carries no light (the back of a
+    /// one-sided emitter).
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample>;
 
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to
@@ -361,7 +370,7 @@ pub struct EmitterRef {
 pub struct LightSet {
     lights: Vec<Box<dyn Light>>,
     environment: Option<(usize, Arc<Environment>)>,
-    selectors: Vec<OnceLock<Option<Box<dyn LightSelector>>>>,
+    selectors: Vec<OnceLock<Result<Box<dyn LightSelector>, String>>>,
 }
 
 impl std::fmt::Debug for LightSet {
@@ -426,16 +435,18 @@ impl LightSet {
         self.environment.as_ref().map(|(_, e)| e)
     }
 
-    /// The selector of type `kind` over these lights, built on first use; None when it
-    /// cannot select (no light with positive power).
-    pub fn selector(&self, kind: &'static SelectorType) -> Option<&dyn LightSelector> {
+    /// The selector of type `kind` over these lights, built on first use; Err says why it
+    /// cannot select among them (no light with positive power, too many lights for an O(n)
+    /// selector).
+    pub fn selector(&self, kind: &'static SelectorType) -> Result<&dyn LightSelector, String> {
         let k = SELECTORS
             .iter()
             .position(|s| std::ptr::eq(*s, kind))
             .expect("selector types come from SELECTORS");
-        self.selectors[k]
-            .get_or_init(|| (kind.build)(&self.lights))
-            .as_deref()
+        match self.selectors[k].get_or_init(|| (kind.build)(&self.lights)) {
+            Ok(s) => Ok(s.as_ref()),
+            Err(why) => Err(why.clone()),
+        }
     }
 
     /// Picks a light with `sel` and samples it by `m`; the returned pdf includes the
@@ -448,7 +459,7 @@ impl LightSet {
         u: [f32; 3],
         m: &LightMethods,
     ) -> Option<(usize, LightSample)> {
-        let (i, pmf) = sel.sample(ctx, u_select)?;
+        let (i, pmf) = sel.sample(ctx, selection_number(u_select, u[2]))?;
         let mut s = self.lights[i].sample(ctx, u, m)?;
         s.pdf *= pmf;
         Some((i, s))
@@ -494,4 +505,14 @@ impl LightSet {
     pub fn emitted(&self, e: EmitterRef, ng: Vec3, w: Vec3) -> Vec3 {
         self.lights[e.light as usize].emitted(ng, w, e.local)
     }
+}
+
+/// One selection number in [0, 1) with 48 random bits from two 24-bit sample dimensions: `hi`
+/// on its 2^-24 grid plus `lo` below it. With one f32, each of a million equally likely lights
+/// would get 16 or 17 multiples of 2^-24 — a pmf off by 6 % — and a tree descent that
+/// rescales u at every level has no bits left after 24 binary choices (sampling.md,
+/// pitfall 18).
+pub fn selection_number(hi: f32, lo: f32) -> f64 {
+    const GRID: f64 = 16_777_216.0;
+    (hi as f64 * GRID).floor() / GRID + lo as f64 / GRID
 }

@@ -1,5 +1,6 @@
 //! Isotropic point light: intensity I = Φ/(4π); irradiance I·cosθ/d² (inverse-square law).
 
+use super::bounds::{Bounds, LightBounds};
 use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, direction_to};
 use crate::math::luminance;
 use glam::Vec3;
@@ -34,6 +35,10 @@ impl Light for PointLight {
 
     fn power(&self) -> f32 {
         4.0 * std::f32::consts::PI * luminance(self.intensity)
+    }
+
+    fn bounds(&self) -> Bounds {
+        Bounds::Local(LightBounds::point(self.position, luminance(self.intensity)))
     }
 
     fn sample(&self, ctx: &LightCtx, _u: [f32; 3], _m: &LightMethods) -> Option<LightSample> {

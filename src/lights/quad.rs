@@ -2,6 +2,7 @@
 //! Area sampling: a uniform point q, pdf_A = 1/A, converted to solid angle at p by
 //! pdf_ω = pdf_A · d² / |cos θ_l| (Veach 1997, eq. 8.10).
 
+use super::bounds::{Bounds, LightBounds};
 use super::{
     Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, QuadMethod, direction_to,
 };
@@ -138,6 +139,16 @@ impl Light for QuadLight {
 
     fn power(&self) -> f32 {
         std::f32::consts::PI * self.area * luminance(self.radiance)
+    }
+
+    fn bounds(&self) -> Bounds {
+        let (c, u, v) = (self.corner, self.edge_u, self.edge_v);
+        Bounds::Local(LightBounds::flat(
+            &[c, c + u, c + v, c + u + v],
+            self.normal,
+            luminance(self.radiance),
+            self.area,
+        ))
     }
 
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {

@@ -4,6 +4,7 @@
 //! 1 - cos θmax computed stably. From inside the sphere the cone is undefined and the
 //! sampler switches to uniform area sampling over the whole sphere, converted to solid angle.
 
+use super::bounds::{Bounds, LightBounds};
 use super::{
     Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, SphereMethod, direction_to,
 };
@@ -281,6 +282,19 @@ impl Light for SphereLight {
     fn power(&self) -> f32 {
         // Outward power; the inward face only matters to points inside.
         PI * 4.0 * PI * self.radius * self.radius * luminance(self.radiance)
+    }
+
+    /// Every direction, with intensity L·πr² (the projected disk) into each.
+    fn bounds(&self) -> Bounds {
+        let r = Vec3::splat(self.radius);
+        Bounds::Local(LightBounds {
+            lo: self.center - r,
+            hi: self.center + r,
+            ..LightBounds::point(
+                self.center,
+                PI * self.radius * self.radius * luminance(self.radiance),
+            )
+        })
     }
 
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {

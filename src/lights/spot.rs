@@ -3,6 +3,7 @@
 //! outside the cone θe, Hermite smoothstep in cos θ between (pbrt-v4 `SpotLight::I`). With
 //! θs = θe the edge is hard.
 
+use super::bounds::{Bounds, LightBounds};
 use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, direction_to};
 use crate::math::luminance;
 use glam::Vec3;
@@ -57,6 +58,22 @@ impl Light for SpotLight {
         2.0 * std::f32::consts::PI
             * ((1.0 - self.cos_falloff_start) + 0.5 * (self.cos_falloff_start - self.cos_cone))
             * luminance(self.intensity)
+    }
+
+    /// Full intensity within θs of the axis (the normal cone), falling off over θc − θs
+    /// beyond it (pbrt-v4 `SpotLight::Bounds`). The angles are those of the stored f32
+    /// cosines widened by the rounding of the f32 cosine `falloff` is called with (a few ulps
+    /// near 1, up to 5e-4 rad for a cone of a few arc seconds), and rounded up.
+    fn bounds(&self) -> Bounds {
+        let widen = |c: f32| ((c as f64 - 4.0 * f32::EPSILON as f64).max(-1.0)).acos();
+        let (theta_s, theta_c) = (widen(self.cos_falloff_start), widen(self.cos_cone));
+        let up = |x: f64| (x as f32).next_up().min(std::f32::consts::PI);
+        Bounds::Local(LightBounds {
+            axis: self.axis,
+            theta_o: up(theta_s),
+            theta_e: up((theta_c - theta_s).max(0.0)),
+            ..LightBounds::point(self.position, luminance(self.intensity))
+        })
     }
 
     fn sample(&self, ctx: &LightCtx, _u: [f32; 3], _m: &LightMethods) -> Option<LightSample> {

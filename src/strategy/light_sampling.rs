@@ -81,16 +81,13 @@ pub struct BoundLights<'s> {
 
 impl<'s> BoundLights<'s> {
     /// `methods` as the scene can use them, in the view's environment representation; Err
-    /// when the selector cannot select (no light with positive power).
+    /// when the selector cannot select (no light with positive power, too many lights).
     pub fn bind(
         scene: &SceneView<'s>,
         selector: &'static SelectorType,
         methods: LightMethods,
     ) -> Result<Self, String> {
-        let selector = scene
-            .lights
-            .selector(selector)
-            .ok_or_else(|| "no light with positive power".to_string())?;
+        let selector = scene.lights.selector(selector)?;
         Ok(BoundLights {
             lights: scene.lights,
             selector,
@@ -178,6 +175,10 @@ impl Strategy for LightSampling {
         match (self.env, self.method) {
             (Some(_), _) => "as `light`, but the environment looked up and sampled in this representation by this sampler (cdf: marginal/conditional, hier: hierarchical warping)".into(),
             (None, Some(o)) => format!("as `light`, but {}", o.describe()),
+            (None, None) if self.selector != default_selector() => format!(
+                "as `light`, but the light chosen by the `{}` selector: {}",
+                self.selector.name, self.selector.describe
+            ),
             (None, None) => "power-proportional light choice; quad/mesh: uniform area, sphere: uniform cone, point/spot/directional: exact".into(),
         }
     }

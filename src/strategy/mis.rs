@@ -90,6 +90,11 @@ impl Strategy for Mis {
     fn describe(&self) -> String {
         match self.env {
             Some(_) => "as `mis-power`, with the environment looked up and sampled in this representation by this sampler".into(),
+            None if self.selector != default_selector() => format!(
+                "as `mis-{}`, but the light chosen by the `{}` selector",
+                self.heuristic.name(),
+                self.selector.name
+            ),
             None => format!(
                 "one light sample (solid angle) + one BSDF sample, {} heuristic",
                 self.heuristic.name()
