@@ -317,19 +317,16 @@ fn every_sampler_estimates_the_albedo() {
             for s in samplings() {
                 k += 1;
                 let st = sampled_albedo(&b, wo, s, 400_000, k);
-                for c in 0..3 {
-                    let zc = st[c].z_score(q.value[c]);
+                for (c, w) in st.iter().enumerate() {
+                    let zc = w.z_score(q.value[c]);
                     assert!(
                         zc.abs() < z,
                         "{name} θo {t}° {s:?} channel {c}: {} ± {:.2e} vs quadrature {} (z = {zc:.2})",
-                        st[c].mean,
-                        st[c].std_error(),
+                        w.mean,
+                        w.std_error(),
                         q.value[c]
                     );
-                    assert!(
-                        st[c].std_error() * z < 0.02 * q.value[c],
-                        "{name}: too blunt"
-                    );
+                    assert!(w.std_error() * z < 0.02 * q.value[c], "{name}: too blunt");
                 }
             }
         }
