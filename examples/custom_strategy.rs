@@ -31,7 +31,7 @@ impl Estimator for OneSample<'_> {
     }
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
         let (coin, light, bsdf) = (u.get_1d(), u.get::<4>(), u.get_3d());
-        let policy = LobeSelection::default();
+        let policy = BsdfSampling::default();
         if coin >= 0.5 {
             let s = sp.bsdf.sample(bsdf, policy); // emission_weight finishes the mixture weight
             return emission_probe_with(sp, s.wi, 2.0 * s.f, s.pdf);

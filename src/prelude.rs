@@ -1,7 +1,7 @@
 //! What a strategy written outside the crate needs, in one import:
 //! `use dibench::prelude::*;` (see `examples/custom_strategy.rs` and `docs/extending.md`).
 
-pub use crate::bsdf::{Bsdf, BsdfSample, LobeSelection};
+pub use crate::bsdf::{Bsdf, BsdfSample, BsdfSampling, LobeSelection};
 pub use crate::lights::selector::default_selector;
 pub use crate::lights::{LightMethods, LightSample};
 pub use crate::prepare::{SceneView, SurfaceHit};

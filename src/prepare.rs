@@ -220,11 +220,7 @@ impl PreparedScene {
             }));
             (lights.len() - 1, env)
         });
-        let materials = scene
-            .materials
-            .iter()
-            .map(|m| Bsdf::blend(m.albedo, m.specular, m.exponent))
-            .collect();
+        let materials = scene.materials.iter().map(|m| m.bsdf.clone()).collect();
         let geometry = Arc::new(g);
         let tracer = make_tracer(geometry.clone());
         PreparedScene {

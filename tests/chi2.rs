@@ -11,17 +11,27 @@ const FAMILY_ALPHA: f64 = 0.01;
 
 #[test]
 fn every_sampler_passes_chi2() {
+    use rayon::prelude::*;
     let entries = registry();
     let cases: Vec<_> = entries
         .iter()
-        .filter(|e| !e.expect_fail)
-        .flat_map(|e| e.suite_params().into_iter().map(move |p| (e, p)))
+        .enumerate()
+        .filter(|(_, e)| !e.expect_fail)
+        .flat_map(|(i, e)| e.suite_params().into_iter().map(move |p| (i, p)))
         .collect();
     let alpha = sidak(FAMILY_ALPHA, cases.len() + 1);
     let mut failures = Vec::new();
-    for (k, (entry, params)) in cases.iter().enumerate() {
-        let case = (entry.build)(params).unwrap();
-        let r = run(&case, SAMPLES, 40, 80, 1000 + k as u64);
+    // Cases run in parallel (a case's closures are not Send, so each worker builds its own
+    // from a fresh registry); the seeds stay per case, so the results do not change.
+    let results: Vec<_> = cases
+        .par_iter()
+        .enumerate()
+        .map(|(k, (i, params))| {
+            let case = (registry()[*i].build)(params).unwrap();
+            run(&case, SAMPLES, 40, 80, 1000 + k as u64)
+        })
+        .collect();
+    for r in results {
         eprintln!(
             "{:<60} p = {:.4} (χ² {:.1}, dof {})",
             r.label, r.p_value, r.chi2, r.dof
@@ -113,4 +123,55 @@ fn an_environment_pdf_without_its_jacobian_fails() {
         "the Jacobian-free pdf passed (p = {})",
         r.p_value
     );
+}
+
+/// The GGX χ² cases have teeth: a visible-normal pdf that forgets its G1(wo) term,
+/// D(h)/(4 cos θo) for the reflected direction, is rejected at views where G1 < 1.
+#[test]
+fn a_vndf_pdf_without_g1_fails() {
+    use dibench::bsdf::MicrofacetSampler;
+    use dibench::bsdf::ggx::{Ggx, chi2_view, ggx_warp_case};
+    for (alpha, theta) in [(0.3f32, 60.0f32), (1.0, 89.0), (0.05, 89.0)] {
+        let g = Ggx {
+            ax: alpha,
+            ay: alpha,
+        };
+        let wo = chi2_view(theta);
+        let case = ggx_warp_case(
+            format!("vndf without G1 (alpha {alpha}, theta_o {theta})"),
+            g,
+            wo,
+            move |u| MicrofacetSampler::Vndf.sample_half_vector(&g, wo, u),
+            move |h| {
+                if wo.dot(h) > 0.0 {
+                    g.d(h) / (4.0 * wo.z)
+                } else {
+                    0.0
+                }
+            },
+        );
+        let r = run(&case, SAMPLES, 40, 80, 13);
+        assert!(
+            r.p_value < 1e-6 || r.hard_failure.is_some(),
+            "{}: passed (p = {})",
+            r.label,
+            r.p_value
+        );
+        // And the right pdf passes the same configuration.
+        let right = ggx_warp_case(
+            "vndf".into(),
+            g,
+            wo,
+            move |u| MicrofacetSampler::Vndf.sample_half_vector(&g, wo, u),
+            move |h| MicrofacetSampler::Vndf.pdf_half(&g, wo, h),
+        );
+        let r = run(&right, SAMPLES, 40, 80, 13);
+        assert!(
+            r.passes(1e-3),
+            "{}: p = {} {:?}",
+            r.label,
+            r.p_value,
+            r.hard_failure
+        );
+    }
 }

@@ -1,6 +1,9 @@
-//! Lambertian reflection kd/π, sampled cosine-weighted (Malley's method).
+//! Lambertian reflection kd/π, sampled cosine-weighted (Malley's method); the `diffuse`
+//! material type.
 
-use super::Lobe;
+use super::material::{MaterialType, Params};
+use super::{Bsdf, Lobe, MicrofacetSampler};
+use crate::error::Result;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
@@ -18,11 +21,11 @@ impl Lobe for Lambert {
         self.kd * FRAC_1_PI
     }
 
-    fn sample(&self, _wo: Vec3, u: [f32; 2]) -> Vec3 {
+    fn sample(&self, _wo: Vec3, u: [f32; 2], _: MicrofacetSampler) -> Vec3 {
         sample_cosine_hemisphere(u)
     }
 
-    fn pdf(&self, _wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, _wo: Vec3, wi: Vec3, _: MicrofacetSampler) -> f32 {
         cosine_hemisphere_pdf(wi.z)
     }
 
@@ -33,4 +36,17 @@ impl Lobe for Lambert {
     fn is_cosine_sampled(&self) -> bool {
         true
     }
+}
+
+/// `type = "diffuse"`: `albedo` (kd per channel in [0, 1], default black).
+pub static DIFFUSE: MaterialType = MaterialType {
+    name: "diffuse",
+    describe: "Lambertian reflection of albedo kd",
+    fields: &["albedo"],
+    parse: parse_diffuse,
+};
+
+fn parse_diffuse(p: &mut Params) -> Result<Bsdf> {
+    let albedo = p.rgb_in("albedo", 0.0, 1.0)?.unwrap_or(Vec3::ZERO);
+    Ok(Bsdf::lambertian(albedo))
 }

@@ -1,37 +1,85 @@
 //! Surface reflectance as a set of lobes, each evaluated and sampled in the local shading
 //! frame (z = shading normal, on the viewer's side), one file per lobe (after tray_rust's
 //! `bxdf/`). A BSDF samples by first choosing a lobe — the [`LobeSelection`] policy, a part of
-//! the strategy — then a direction from that lobe; its pdf is the mixture of every lobe's
-//! pdf (the lecture's multi-lobe recipe), so any lobe's direction is weighted correctly.
+//! the strategy — then a direction from that lobe, by the lobe's own sampler (the
+//! [`MicrofacetSampler`] part, for lobes that have several); its pdf is the mixture of every
+//! lobe's pdf (the lecture's multi-lobe recipe), so any lobe's direction is weighted correctly.
+//!
+//! Material types (`type` in a scene's `[[material]]`) are registered in [`MATERIALS`], each
+//! beside the lobe it builds on; `material` parses and validates their fields.
 //!
 //! Reflection only: every lobe is zero for directions below the surface (wi.z ≤ 0).
 
-pub mod lambert;
-pub mod phong;
+pub mod fresnel;
+pub mod material;
+pub mod quadrature;
+
+crate::plugin::registry! {
+    /// Every material type, in listing order.
+    pub static MATERIALS: material::MaterialType = [
+        lambert::DIFFUSE,
+        phong::PHONG,
+        ggx::GGX,
+        principled::PRINCIPLED,
+    ];
+}
+
+pub use crate::sampling::microfacet::MicrofacetSampler;
 
 use crate::math::{Frame, luminance};
 use glam::Vec3;
 use std::sync::Arc;
 
-/// One reflectance lobe in the local shading frame (wo.z > 0 always).
+/// One reflectance lobe in the local shading frame (wo.z > 0 for a point seen from outside;
+/// wo.z ≤ 0 only for a point seen exactly edge-on, where a lobe may reflect nothing).
 pub trait Lobe: Send + Sync + std::fmt::Debug {
     /// f(wo, wi); zero for wi.z ≤ 0.
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3;
 
-    /// A direction drawn from this lobe's own density [`Self::pdf`]; it may lie below the
-    /// surface (f = 0 there), so the pdf stays a density over the whole sphere.
-    fn sample(&self, wo: Vec3, u: [f32; 2]) -> Vec3;
+    /// f(wo, wi) when the half vector h = normalize(wo + wi) is known exactly (a quadrature over
+    /// half vectors): a lobe that depends on h uses it instead of recovering it from wi, which
+    /// near the horizon loses the digits a narrow lobe lives in. Default: [`Self::eval`].
+    fn eval_with_half_vector(&self, wo: Vec3, wi: Vec3, _h: Vec3) -> Vec3 {
+        self.eval(wo, wi)
+    }
+
+    /// A direction drawn from this lobe's own density [`Self::pdf`] (by `sampler` if the lobe
+    /// is a microfacet lobe; other lobes ignore it); it may lie below the surface (f = 0 there),
+    /// so the pdf stays a density over the whole sphere.
+    fn sample(&self, wo: Vec3, u: [f32; 2], sampler: MicrofacetSampler) -> Vec3;
 
     /// Solid-angle density of [`Self::sample`].
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    fn pdf(&self, wo: Vec3, wi: Vec3, sampler: MicrofacetSampler) -> f32;
 
     /// The lobe's reflectance coefficient: the weight the by-coefficient policy gives it.
     fn coefficient(&self) -> Vec3;
+
+    /// An estimate of the lobe's directional albedo ∫ f cos dωi at `wo`, for the by-albedo
+    /// policy: the coefficient unless the lobe knows better (Fresnel at the view angle).
+    fn albedo_estimate(&self, _wo: Vec3) -> Vec3 {
+        self.coefficient()
+    }
+
+    /// [`Self::albedo_estimate`] can differ from the coefficient.
+    fn estimates_albedo(&self) -> bool {
+        false
+    }
 
     /// Sampling this lobe is cosine-weighted hemisphere sampling (so a strategy can tell when
     /// BSDF sampling would only repeat `cosine`).
     fn is_cosine_sampled(&self) -> bool {
         false
+    }
+
+    /// The lobe is sampled by the [`MicrofacetSampler`] it is given.
+    fn is_microfacet(&self) -> bool {
+        false
+    }
+
+    /// The spread (αx, αy) of the lobe's half vectors about the normal, as a GGX roughness: the
+    /// scale a quadrature over half vectors must resolve ([1, 1] for a smooth lobe).
+    fn half_vector_spread(&self) -> [f32; 2] {
+        [1.0, 1.0]
     }
 }
 
@@ -41,6 +89,89 @@ pub enum LobeSelection {
     /// In proportion to each lobe's coefficient luminance (the lecture's recipe).
     #[default]
     Coefficient,
+    /// In proportion to the luminance of each lobe's directional-albedo estimate at the view
+    /// direction (Fresnel-weighted; Mitsuba 3's `principled` picks lobes this way).
+    Albedo,
+}
+
+impl LobeSelection {
+    pub const ALL: [LobeSelection; 2] = [LobeSelection::Coefficient, LobeSelection::Albedo];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            LobeSelection::Coefficient => "select-coefficient",
+            LobeSelection::Albedo => "select-albedo",
+        }
+    }
+}
+
+/// The BSDF-sampling part of a strategy: how a lobe is chosen, and which sampler a microfacet
+/// lobe draws with. The defaults are dibench's original BSDF sampling (and their names add
+/// nothing to a strategy's name).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct BsdfSampling {
+    pub lobes: LobeSelection,
+    pub microfacet: MicrofacetSampler,
+}
+
+impl BsdfSampling {
+    /// The variants beside the default that the strategy registry lists: each GGX sampler
+    /// other than the default, and selection by albedo estimate.
+    pub fn variants() -> Vec<BsdfSampling> {
+        let mut v: Vec<BsdfSampling> = MicrofacetSampler::ALL
+            .into_iter()
+            .filter(|&m| m != MicrofacetSampler::default())
+            .map(|microfacet| BsdfSampling {
+                microfacet,
+                ..Default::default()
+            })
+            .collect();
+        v.push(BsdfSampling {
+            lobes: LobeSelection::Albedo,
+            ..Default::default()
+        });
+        v
+    }
+
+    /// What this part adds to a strategy's name: `-ggx-ndf`, `-select-albedo`, nothing for
+    /// the defaults.
+    pub fn name_suffix(&self) -> String {
+        let mut s = String::new();
+        if self.microfacet != MicrofacetSampler::default() {
+            s += "-";
+            s += self.microfacet.name();
+        }
+        if self.lobes != LobeSelection::default() {
+            s += "-";
+            s += self.lobes.name();
+        }
+        s
+    }
+
+    pub fn describe(&self) -> String {
+        let lobes = match self.lobes {
+            LobeSelection::Coefficient => "lobe chosen by coefficient",
+            LobeSelection::Albedo => "lobe chosen by albedo estimate",
+        };
+        format!("{lobes}, {}", self.microfacet.describe())
+    }
+
+    /// Why sampling `materials` this way would repeat the default sampling exactly, if it
+    /// would: no lobe uses the microfacet sampler, or no lobe estimates its albedo.
+    pub fn same_as_default(&self, materials: &[Bsdf]) -> Option<String> {
+        if self.microfacet != MicrofacetSampler::default()
+            && !materials.iter().any(Bsdf::has_microfacet)
+        {
+            return Some("no material has a microfacet (GGX) lobe".into());
+        }
+        if self.lobes != LobeSelection::default() && !materials.iter().any(Bsdf::estimates_albedo) {
+            return Some(
+                "no material has several lobes with an albedo estimate apart from its coefficient"
+                    .into(),
+            );
+        }
+        None
+    }
 }
 
 /// A BSDF sample: the world direction with f and the mixture pdf for it.
@@ -51,33 +182,56 @@ pub struct BsdfSample {
     pub pdf: f32,
 }
 
+/// The most lobes a material may have (selection probabilities live on the stack).
+pub const MAX_LOBES: usize = 4;
+
+/// Lobe selection probabilities, in lobe order (zero beyond the lobe count).
+type Selection = [f32; MAX_LOBES];
+
 /// A material's lobes. Cheap to clone (the lobes are shared).
 #[derive(Clone, Debug)]
 pub struct Bsdf {
     lobes: Vec<Arc<dyn Lobe>>,
     /// Selection probabilities by coefficient, in lobe order; the last is 1 − Σ of the others
     /// so that they sum to one exactly.
-    by_coefficient: Vec<f32>,
+    by_coefficient: Selection,
+}
+
+/// Probabilities proportional to `weights` (non-negative), the last one 1 − Σ of the others;
+/// None when they are all zero.
+fn normalised(weights: &[f32]) -> Option<Selection> {
+    let total: f32 = weights.iter().sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    let mut p = [0.0; MAX_LOBES];
+    let mut acc = 0.0;
+    for (i, w) in weights.iter().enumerate() {
+        p[i] = if i + 1 == weights.len() {
+            1.0 - acc
+        } else {
+            w / total
+        };
+        acc += p[i];
+    }
+    Some(p)
 }
 
 impl Bsdf {
+    /// A material of 1 to [`MAX_LOBES`] lobes.
     pub fn new(lobes: Vec<Arc<dyn Lobe>>) -> Self {
+        assert!(
+            !lobes.is_empty() && lobes.len() <= MAX_LOBES,
+            "a material has 1 to {MAX_LOBES} lobes, got {}",
+            lobes.len()
+        );
         let weights: Vec<f32> = lobes.iter().map(|l| luminance(l.coefficient())).collect();
-        let total: f32 = weights.iter().sum();
-        let mut by_coefficient = Vec::with_capacity(weights.len());
-        let mut acc = 0.0;
-        for (i, w) in weights.iter().enumerate() {
-            let p = if i + 1 == weights.len() {
-                1.0 - acc
-            } else if total > 0.0 {
-                w / total
-            } else {
-                // No reflectance at all: sample the first lobe (every f is zero anyway).
-                if i == 0 { 1.0 } else { 0.0 }
-            };
-            acc += p;
-            by_coefficient.push(p);
-        }
+        // No reflectance at all: sample the first lobe (every f is zero anyway).
+        let by_coefficient = normalised(&weights).unwrap_or_else(|| {
+            let mut p = [0.0; MAX_LOBES];
+            p[0] = 1.0;
+            p
+        });
         Bsdf {
             lobes,
             by_coefficient,
@@ -87,12 +241,21 @@ impl Bsdf {
     /// Diffuse kd plus normalized-Phong ks with exponent n: the lecture's blend (either part
     /// left out when its coefficient is zero; a black material keeps a black Lambert lobe).
     pub fn blend(kd: Vec3, ks: Vec3, exponent: f32) -> Self {
+        Self::blend_with(kd, ks, |ks| Arc::new(phong::Phong { ks, exponent }))
+    }
+
+    /// Diffuse kd plus a GGX lobe of coefficient ks: the lecture's "blend microfacet model".
+    pub fn blend_ggx(kd: Vec3, ks: Vec3, dist: ggx::Ggx, fresnel: fresnel::Fresnel) -> Self {
+        Self::blend_with(kd, ks, |ks| Arc::new(ggx::GgxLobe { ks, dist, fresnel }))
+    }
+
+    fn blend_with(kd: Vec3, ks: Vec3, glossy: impl FnOnce(Vec3) -> Arc<dyn Lobe>) -> Self {
         let mut lobes: Vec<Arc<dyn Lobe>> = Vec::new();
         if kd != Vec3::ZERO || ks == Vec3::ZERO {
             lobes.push(Arc::new(lambert::Lambert { kd }));
         }
         if ks != Vec3::ZERO {
-            lobes.push(Arc::new(phong::Phong { ks, exponent }));
+            lobes.push(glossy(ks));
         }
         Self::new(lobes)
     }
@@ -110,8 +273,29 @@ impl Bsdf {
         self.lobes.iter().all(|l| l.is_cosine_sampled())
     }
 
-    fn selection(&self, _policy: LobeSelection) -> &[f32] {
-        &self.by_coefficient
+    /// Some lobe is sampled by the strategy's [`MicrofacetSampler`].
+    pub fn has_microfacet(&self) -> bool {
+        self.lobes.iter().any(|l| l.is_microfacet())
+    }
+
+    /// Selection by albedo estimate can differ from selection by coefficient.
+    pub fn estimates_albedo(&self) -> bool {
+        self.lobes.len() > 1 && self.lobes.iter().any(|l| l.estimates_albedo())
+    }
+
+    /// The lobe probabilities under `policy` for view `wo`. By albedo they fall back to the
+    /// coefficients when every estimate is zero.
+    fn selection(&self, policy: LobeSelection, wo: Vec3) -> Selection {
+        match policy {
+            LobeSelection::Coefficient => self.by_coefficient,
+            LobeSelection::Albedo => {
+                let mut w = [0.0f32; MAX_LOBES];
+                for (w, l) in w.iter_mut().zip(&self.lobes) {
+                    *w = luminance(l.albedo_estimate(wo)).max(0.0);
+                }
+                normalised(&w[..self.lobes.len()]).unwrap_or(self.by_coefficient)
+            }
+        }
     }
 
     /// Σ f over the lobes, in the local frame.
@@ -123,30 +307,30 @@ impl Bsdf {
         f
     }
 
-    /// Mixture pdf of [`Self::sample`] under `policy`, in the local frame.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, policy: LobeSelection) -> f32 {
+    /// Mixture pdf of [`Self::sample_local`] under `sampling`, in the local frame.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3, sampling: BsdfSampling) -> f32 {
         let mut pdf = 0.0;
-        for (l, &p) in self.lobes.iter().zip(self.selection(policy)) {
+        for (l, &p) in self.lobes.iter().zip(&self.selection(sampling.lobes, wo)) {
             if p > 0.0 {
-                pdf += p * l.pdf(wo, wi);
+                pdf += p * l.pdf(wo, wi, sampling.microfacet);
             }
         }
         pdf
     }
 
     /// u[2] chooses the lobe, u[0..2] the direction within it; local frame.
-    pub fn sample_local(&self, wo: Vec3, u: [f32; 3], policy: LobeSelection) -> Vec3 {
-        let probs = self.selection(policy);
+    pub fn sample_local(&self, wo: Vec3, u: [f32; 3], sampling: BsdfSampling) -> Vec3 {
+        let probs = self.selection(sampling.lobes, wo);
         let mut cdf = 0.0;
         let mut chosen = self.lobes.len() - 1;
-        for (i, &p) in probs.iter().enumerate() {
+        for (i, &p) in probs[..self.lobes.len()].iter().enumerate() {
             cdf += p;
             if u[2] < cdf {
                 chosen = i;
                 break;
             }
         }
-        self.lobes[chosen].sample(wo, [u[0], u[1]])
+        self.lobes[chosen].sample(wo, [u[0], u[1]], sampling.microfacet)
     }
 }
 
@@ -175,35 +359,36 @@ impl LocalBsdf<'_> {
         self.bsdf.eval(self.wo, wi)
     }
 
-    pub fn pdf(&self, wi: Vec3, policy: LobeSelection) -> f32 {
-        self.bsdf.pdf(self.wo, self.frame.to_local(wi), policy)
+    pub fn pdf(&self, wi: Vec3, sampling: BsdfSampling) -> f32 {
+        self.bsdf.pdf(self.wo, self.frame.to_local(wi), sampling)
     }
 
     /// The pdf of a direction already in the shading frame.
-    pub fn pdf_local(&self, wi: Vec3, policy: LobeSelection) -> f32 {
-        self.bsdf.pdf(self.wo, wi, policy)
+    pub fn pdf_local(&self, wi: Vec3, sampling: BsdfSampling) -> f32 {
+        self.bsdf.pdf(self.wo, wi, sampling)
     }
 
     /// A world direction with f and pdf evaluated for the direction as rounded to world space,
     /// so value and density describe the same direction.
-    pub fn sample(&self, u: [f32; 3], policy: LobeSelection) -> BsdfSample {
+    pub fn sample(&self, u: [f32; 3], sampling: BsdfSampling) -> BsdfSample {
         let wi = self
             .frame
-            .to_world(self.bsdf.sample_local(self.wo, u, policy));
+            .to_world(self.bsdf.sample_local(self.wo, u, sampling));
         let local = self.frame.to_local(wi);
         BsdfSample {
             wi,
             f: self.bsdf.eval(self.wo, local),
-            pdf: self.bsdf.pdf(self.wo, local, policy),
+            pdf: self.bsdf.pdf(self.wo, local, sampling),
         }
     }
 }
 
-/// The χ² case of BSDF sampling: the diffuse + Phong blend, lobe chosen by coefficient, with
-/// the mixture pdf, seen from `theta_o` off the normal.
+/// The χ² cases of BSDF sampling: the diffuse + Phong blend, lobe chosen by coefficient, with
+/// the mixture pdf, seen from `theta_o` off the normal; then the GGX samplers' and the
+/// principled material's, from their files.
 pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
     use crate::chi2::{Chart, DEFAULT_SLACK, WarpCase, WarpEntry, label, param};
-    vec![WarpEntry::new(
+    let mut v = vec![WarpEntry::new(
         "bsdf-blend",
         "diffuse + normalized Phong blend, lobe chosen by coefficient; wo at theta_o from the normal",
         &[("kd", 0.5), ("ks", 0.4), ("n", 10.0), ("theta_o", 30.0)],
@@ -225,7 +410,7 @@ pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
             let bsdf = Bsdf::blend(Vec3::splat(kd), Vec3::splat(ks), n);
             let b2 = bsdf.clone();
             let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
-            let policy = LobeSelection::Coefficient;
+            let policy = BsdfSampling::default();
             Ok(WarpCase {
                 label: label("bsdf-blend", p),
                 sample: Box::new(move |u| {
@@ -237,7 +422,10 @@ pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
                 chart: Chart::sphere(),
             })
         },
-    )]
+    )];
+    v.extend(ggx::chi2_cases());
+    v.extend(principled::chi2_cases());
+    v
 }
 
 #[cfg(test)]
@@ -274,12 +462,12 @@ mod tests {
     #[test]
     fn selection_by_coefficient() {
         let b = Bsdf::blend(Vec3::splat(0.3), Vec3::splat(0.6), 10.0);
-        let p = b.selection(LobeSelection::Coefficient);
-        assert_eq!(p.len(), 2);
+        let p = b.selection(LobeSelection::Coefficient, Vec3::Z);
+        assert_eq!(p[2..], [0.0, 0.0]);
         assert!((p[0] - 1.0 / 3.0).abs() < 1e-6 && (p[0] + p[1] - 1.0).abs() < 1e-7);
         assert_eq!(
-            Bsdf::lambertian(Vec3::ONE).selection(LobeSelection::Coefficient),
-            [1.0]
+            Bsdf::lambertian(Vec3::ONE).selection(LobeSelection::Coefficient, Vec3::Z),
+            [1.0, 0.0, 0.0, 0.0]
         );
         assert_eq!(Bsdf::lambertian(Vec3::ZERO).lobes().len(), 1);
     }

@@ -2,8 +2,11 @@
 //! of wo (the modified Phong BRDF of Lafortune & Willems 1994, whose directional albedo is at
 //! most ks, so kd + ks ≤ 1 conserves energy), sampled by the Phong lobe warp about the mirror
 //! direction, pdf (n+1)/(2π)·cos^n α (see docs/lecture-errata.md for the lecture's pair).
+//! The `phong` material type is the lecture's blend of a Lambert kd and this lobe.
 
-use super::Lobe;
+use super::material::{MaterialType, Params};
+use super::{Bsdf, Lobe, MicrofacetSampler};
+use crate::error::Result;
 use crate::math::Frame;
 use crate::sampling::warp::{phong_lobe_pdf, sample_phong_lobe};
 use glam::Vec3;
@@ -39,15 +42,55 @@ impl Lobe for Phong {
         self.ks * ((n + 2.0) / (2.0 * PI) * (n * (-omc).ln_1p()).exp())
     }
 
-    fn sample(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
+    fn sample(&self, wo: Vec3, u: [f32; 2], _: MicrofacetSampler) -> Vec3 {
         Frame::from_normal(reflect(wo)).to_world(sample_phong_lobe(u, self.exponent))
     }
 
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf(&self, wo: Vec3, wi: Vec3, _: MicrofacetSampler) -> f32 {
         phong_lobe_pdf(one_minus_cos(reflect(wo), wi), self.exponent)
     }
 
     fn coefficient(&self) -> Vec3 {
         self.ks
     }
+
+    /// The lobe's cos^n α about the mirror direction is, in half vectors, a lobe of angular
+    /// width ~(n + 2)^-1/2 (half the angle in reflected directions).
+    fn half_vector_spread(&self) -> [f32; 2] {
+        let a = (2.0 / (self.exponent + 2.0)).sqrt().min(1.0);
+        [a, a]
+    }
+}
+
+/// `type = "phong"` (and any material without a type that has `specular` or `exponent`):
+/// `albedo` kd, `specular` ks, kd + ks ≤ 1 per channel, and `exponent` n ≥ 0 (required when
+/// ks is non-zero).
+pub static PHONG: MaterialType = MaterialType {
+    name: "phong",
+    describe: "Lambert kd + normalized Phong ks with exponent n (the lecture's blend)",
+    fields: &["albedo", "specular", "exponent"],
+    parse: parse_phong,
+};
+
+fn parse_phong(p: &mut Params) -> Result<Bsdf> {
+    let albedo = p.rgb("albedo")?.unwrap_or(Vec3::ZERO);
+    let specular = p.rgb("specular")?.unwrap_or(Vec3::ZERO);
+    if albedo.min_element() < 0.0
+        || specular.min_element() < 0.0
+        || (albedo + specular).max_element() > 1.0
+    {
+        return Err(p.error(
+            "",
+            "albedo and specular must be non-negative with albedo + specular ≤ 1 per channel (energy conservation)",
+        ));
+    }
+    let exponent = match p.number("exponent")? {
+        Some(e) if e < 0.0 => return Err(p.error("exponent", "must be ≥ 0")),
+        Some(e) => e,
+        None if specular != Vec3::ZERO => {
+            return Err(p.error("exponent", "required when `specular` is non-zero"));
+        }
+        None => 0.0,
+    };
+    Ok(Bsdf::blend(albedo, specular, exponent))
 }

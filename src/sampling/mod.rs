@@ -3,6 +3,7 @@
 
 pub mod discrete;
 pub mod generator;
+pub mod microfacet;
 pub mod spherical;
 pub mod stream;
 pub mod warp;

@@ -67,18 +67,17 @@ pub struct ImageDesc {
     pub height: u32,
 }
 
+/// A material: its name, its type, and the type's own fields, which the type parses and
+/// validates (`bsdf::MATERIALS`; unknown fields are errors there). Without a `type`, a material
+/// with `specular` or `exponent` is `phong` (albedo kd + normalized Phong ks, exponent n) and
+/// any other `diffuse` (albedo kd), as before types existed.
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
     pub name: String,
-    /// Diffuse (Lambertian) reflectance kd per channel.
-    #[serde(default)]
-    pub albedo: Triple,
-    /// Glossy reflectance ks of a normalized Phong lobe; kd + ks ≤ 1 per channel.
-    #[serde(default)]
-    pub specular: Triple,
-    /// Phong exponent n ≥ 0 (required when `specular` is non-zero).
-    pub exponent: Option<f32>,
+    #[serde(rename = "type")]
+    pub kind: Option<String>,
+    #[serde(flatten)]
+    pub fields: toml::Table,
 }
 
 #[derive(Debug, Deserialize)]

@@ -78,13 +78,13 @@ pub struct Camera {
     pub tan_half_fov_y: f32,
 }
 
-/// Diffuse kd plus normalized-Phong ks with exponent (see `bsdf`).
+/// A named material: its type (`diffuse`, `phong`, `ggx`, `principled`) and its lobes, as the
+/// type built them from the file's fields (see `bsdf::MATERIALS`).
 #[derive(Clone, Debug)]
 pub struct Material {
     pub name: String,
-    pub albedo: Vec3,
-    pub specular: Vec3,
-    pub exponent: f32,
+    pub kind: &'static str,
+    pub bsdf: crate::bsdf::Bsdf,
 }
 
 #[derive(Clone, Debug)]
@@ -244,36 +244,8 @@ impl Scene {
 
         let mut materials = Vec::new();
         for (i, m) in desc.materials.iter().enumerate() {
-            let albedo = v.vec3(&format!("material[{i}].albedo"), m.albedo)?;
-            let specular = v.vec3(&format!("material[{i}].specular"), m.specular)?;
-            if albedo.min_element() < 0.0
-                || specular.min_element() < 0.0
-                || (albedo + specular).max_element() > 1.0
-            {
-                return Err(Error::field(
-                    path,
-                    format!("material[{i}]"),
-                    "albedo and specular must be non-negative with albedo + specular ≤ 1 per channel (energy conservation)",
-                ));
-            }
-            let exponent = match m.exponent {
-                Some(e) => v.finite(&format!("material[{i}].exponent"), e)?,
-                None if specular != Vec3::ZERO => {
-                    return Err(Error::field(
-                        path,
-                        format!("material[{i}].exponent"),
-                        "required when `specular` is non-zero",
-                    ));
-                }
-                None => 0.0,
-            };
-            if exponent < 0.0 {
-                return Err(Error::field(
-                    path,
-                    format!("material[{i}].exponent"),
-                    "must be ≥ 0",
-                ));
-            }
+            let (kind, bsdf) =
+                crate::bsdf::material::parse(path, i, m.kind.as_deref(), m.fields.clone())?;
             if materials.iter().any(|x: &Material| x.name == m.name) {
                 return Err(Error::field(
                     path,
@@ -283,9 +255,8 @@ impl Scene {
             }
             materials.push(Material {
                 name: m.name.clone(),
-                albedo,
-                specular,
-                exponent,
+                kind: kind.name,
+                bsdf,
             });
         }
         let material = |field: String, name: &str| -> Result<u32> {

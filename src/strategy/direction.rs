@@ -1,9 +1,10 @@
 //! Strategies that sample a direction and find the emitter it reaches: uniform hemisphere
 //! (pdf 1/2π), cosine hemisphere (pdf cos θ/π) and BSDF sampling (the material's lobe
-//! mixture). Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
+//! mixture, by the strategy's [`BsdfSampling`] part: lobe selection and GGX sampler).
+//! Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
 
 use super::{EmissionProbe, Estimator, Probes, ShadingPoint, Strategy};
-use crate::bsdf::LobeSelection;
+use crate::bsdf::BsdfSampling;
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
 use crate::sampling::warp::{
@@ -36,15 +37,24 @@ pub const BSDF_DIMS: [Dimension; 2] = [
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct DirectionSampling {
     pub kind: DirectionKind,
-    /// How `bsdf` picks a lobe (unused by the hemisphere samplers).
-    pub lobes: LobeSelection,
+    /// How `bsdf` picks a lobe and samples a microfacet lobe (unused by the hemisphere
+    /// samplers, which keep the default).
+    pub sampling: BsdfSampling,
 }
 
 impl DirectionSampling {
     pub fn new(kind: DirectionKind) -> Self {
         DirectionSampling {
             kind,
-            lobes: LobeSelection::default(),
+            sampling: BsdfSampling::default(),
+        }
+    }
+
+    /// BSDF sampling with `sampling`: `bsdf` + its name suffix (`bsdf-ggx-ndf`, ...).
+    pub fn bsdf(sampling: BsdfSampling) -> Self {
+        DirectionSampling {
+            kind: DirectionKind::Bsdf,
+            sampling,
         }
     }
 }
@@ -66,11 +76,10 @@ pub fn direction_sampling_applies(scene: &SceneView) -> Result<(), String> {
 impl Strategy for DirectionSampling {
     fn name(&self) -> String {
         match self.kind {
-            DirectionKind::UniformHemisphere => "uniform",
-            DirectionKind::CosineHemisphere => "cosine",
-            DirectionKind::Bsdf => "bsdf",
+            DirectionKind::UniformHemisphere => "uniform".into(),
+            DirectionKind::CosineHemisphere => "cosine".into(),
+            DirectionKind::Bsdf => format!("bsdf{}", self.sampling.name_suffix()),
         }
-        .into()
     }
 
     fn describe(&self) -> String {
@@ -82,7 +91,10 @@ impl Strategy for DirectionSampling {
                 "cosine-weighted hemisphere directions, emission of the first hit"
             }
             DirectionKind::Bsdf => {
-                "BSDF-sampled directions (lobe chosen by coefficient), emission of the first hit"
+                return format!(
+                    "BSDF-sampled directions ({}), emission of the first hit",
+                    self.sampling.describe()
+                );
             }
         }
         .into()
@@ -94,6 +106,9 @@ impl Strategy for DirectionSampling {
             && scene.world.materials.iter().all(|b| b.is_cosine_sampled())
         {
             return Err("identical to `cosine`: every material is Lambertian".into());
+        }
+        if let Some(why) = self.sampling.same_as_default(&scene.world.materials) {
+            return Err(format!("identical to `bsdf`: {why}"));
         }
         Ok(Box::new(*self))
     }
@@ -123,7 +138,7 @@ impl Estimator for DirectionSampling {
                 )
             }
             DirectionKind::Bsdf => {
-                let s = sp.bsdf.sample(u.get_3d(), self.lobes);
+                let s = sp.bsdf.sample(u.get_3d(), self.sampling);
                 return emission_probe_with(sp, s.wi, s.f, s.pdf);
             }
         };

@@ -2,12 +2,13 @@
 //! with the balance or power (β = 2) heuristic. Lights are sampled in solid angle where the
 //! scene allows it; the environment by the representation and sampler the strategy pins, and
 //! BSDF samples that escape see the environment in that same representation. The light pdf
-//! includes the light-selection pmf (redner #56).
+//! includes the light-selection pmf (redner #56). The BSDF sample, and the BSDF pdf of light
+//! samples, follow the strategy's [`BsdfSampling`] part (lobe selection, GGX sampler).
 
 use super::direction::{BSDF_DIMS, emission_probe_with};
 use super::light_sampling::{BoundLights, LIGHT_DIMS, selector_applies, with_selector};
 use super::{EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, Strategy, env_method_name};
-use crate::bsdf::LobeSelection;
+use crate::bsdf::BsdfSampling;
 use crate::env::EnvMethod;
 use crate::lights::selector::{SelectorType, default_selector};
 use crate::lights::{LightMethods, LightShape};
@@ -47,7 +48,7 @@ pub struct Mis {
     /// The environment representation and sampler this variant pins; None: lat/long by CDF.
     pub env: Option<EnvMethod>,
     pub selector: &'static SelectorType,
-    pub lobes: LobeSelection,
+    pub sampling: BsdfSampling,
 }
 
 impl Mis {
@@ -57,7 +58,15 @@ impl Mis {
             heuristic,
             env: None,
             selector: default_selector(),
-            lobes: LobeSelection::default(),
+            sampling: BsdfSampling::default(),
+        }
+    }
+
+    /// Heuristic `heuristic` with the BSDF sampled by `sampling`: `mis-power-ggx-ndf`, ...
+    pub fn with_sampling(heuristic: Heuristic, sampling: BsdfSampling) -> Self {
+        Mis {
+            sampling,
+            ..Self::new(heuristic)
         }
     }
 
@@ -84,11 +93,11 @@ impl Strategy for Mis {
             (Some(e), h) => format!("mis-{}-env-{}", h.name(), env_method_name(e)),
             (None, h) => format!("mis-{}", h.name()),
         };
-        with_selector(base, self.selector)
+        with_selector(format!("{base}{}", self.sampling.name_suffix()), self.selector)
     }
 
     fn describe(&self) -> String {
-        match self.env {
+        let base = match self.env {
             Some(_) => "as `mis-power`, with the environment looked up and sampled in this representation by this sampler".into(),
             None if self.selector != default_selector() => format!(
                 "as `mis-{}`, but the light chosen by the `{}` selector",
@@ -99,6 +108,11 @@ impl Strategy for Mis {
                 "one light sample (solid angle) + one BSDF sample, {} heuristic",
                 self.heuristic.name()
             ),
+        };
+        if self.sampling == BsdfSampling::default() {
+            base
+        } else {
+            format!("{base}; BSDF: {}", self.sampling.describe())
         }
     }
 
@@ -119,6 +133,7 @@ impl Strategy for Mis {
         match self.env {
             Some(_) if !has_env => return Err("the scene has no environment".into()),
             None if self.heuristic == Heuristic::Power
+                && self.sampling == BsdfSampling::default()
                 && scene.lights.len() == 1
                 && scene.lights.has(LightShape::Environment) =>
             {
@@ -127,6 +142,13 @@ impl Strategy for Mis {
                 );
             }
             _ => {}
+        }
+        if let Some(why) = self.sampling.same_as_default(&scene.world.materials) {
+            let default = Mis {
+                sampling: BsdfSampling::default(),
+                ..*self
+            };
+            return Err(format!("identical to `{}`: {why}", default.name()));
         }
         Ok(Box::new(MisEstimator {
             strategy: *self,
@@ -147,18 +169,18 @@ impl Estimator for MisEstimator<'_> {
 
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
         let h = self.strategy.heuristic;
-        let lobes = self.strategy.lobes;
+        let sampling = self.strategy.sampling;
         let shadow = self
             .lights
             .probe(sp, u)
             .map(|(mut probe, ls, local, light)| {
                 // A delta light is reachable by light sampling only: its weight is 1.
                 if !self.lights.lights.get(light).is_delta() {
-                    probe.value *= h.weight(ls.pdf, sp.bsdf.pdf_local(local, lobes));
+                    probe.value *= h.weight(ls.pdf, sp.bsdf.pdf_local(local, sampling));
                 }
                 probe
             });
-        let bs = sp.bsdf.sample(u.get_3d(), lobes);
+        let bs = sp.bsdf.sample(u.get_3d(), sampling);
         let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
         Probes { shadow, emission }
     }

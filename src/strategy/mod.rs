@@ -254,8 +254,10 @@ pub fn env_method_name(m: EnvMethod) -> String {
 }
 
 /// Every strategy dibench knows, in listing order, built from the parts: the direction
-/// samplers, light sampling with each single-shape method override, both MIS heuristics,
-/// both AO estimators, then light sampling and MIS pinned to each environment method.
+/// samplers, BSDF sampling with each other GGX sampler and with lobes chosen by albedo, light
+/// sampling with each single-shape method override, both MIS heuristics, power-heuristic MIS
+/// with each BSDF-sampling variant, both AO estimators, then light sampling and MIS pinned to
+/// each environment method.
 pub fn registry() -> Vec<Box<dyn Strategy>> {
     use direction::{DirectionKind, DirectionSampling};
     use light_sampling::LightSampling;
@@ -264,12 +266,18 @@ pub fn registry() -> Vec<Box<dyn Strategy>> {
     for k in DirectionKind::ALL {
         v.push(Box::new(DirectionSampling::new(k)));
     }
+    for s in crate::bsdf::BsdfSampling::variants() {
+        v.push(Box::new(DirectionSampling::bsdf(s)));
+    }
     v.push(Box::new(LightSampling::basic()));
     for o in crate::lights::MethodOverride::all() {
         v.push(Box::new(LightSampling::with_override(o)));
     }
     for h in Heuristic::ALL {
         v.push(Box::new(Mis::new(h)));
+    }
+    for s in crate::bsdf::BsdfSampling::variants() {
+        v.push(Box::new(Mis::with_sampling(Heuristic::Power, s)));
     }
     for cosine in [false, true] {
         v.push(Box::new(ambient_occlusion::AmbientOcclusion { cosine }));

@@ -37,6 +37,8 @@ pub struct ViewPoint {
     pub kd: f64,
     pub ks: f64,
     pub exponent: f64,
+    /// Shade with the scene's material of this name instead of the kd/ks/exponent blend.
+    pub material: Option<&'static str>,
     /// Find the point by tracing a ray from here towards `p`, and shade the hit exactly as the
     /// renderer does (its computed position and error bound): the self-intersection test.
     pub trace_from: Option<DVec3>,
@@ -52,12 +54,20 @@ impl ViewPoint {
             kd: albedo,
             ks: 0.0,
             exponent: 0.0,
+            material: None,
             trace_from: None,
         }
     }
 
-    /// The point's material.
-    pub fn bsdf(&self) -> Bsdf {
+    /// The point's material: the named scene material, else the kd/ks/exponent blend.
+    pub fn bsdf(&self, scene: &PreparedScene) -> Bsdf {
+        if let Some(name) = self.material {
+            let m = scene.scene.materials.iter().find(|m| m.name == name);
+            return m
+                .expect("a stress case names a material of its scene")
+                .bsdf
+                .clone();
+        }
         Bsdf::blend(
             Vec3::splat(self.kd as f32),
             Vec3::splat(self.ks as f32),
@@ -339,7 +349,11 @@ pub fn run(cases: &[StressCase], samples: u64, seed: u64) -> Result<Vec<StressRo
         .iter()
         .map(StressCase::prepare)
         .collect::<Result<Vec<_>>>()?;
-    let bsdfs: Vec<Bsdf> = cases.iter().map(|c| c.point.bsdf()).collect();
+    let bsdfs: Vec<Bsdf> = cases
+        .iter()
+        .zip(&scenes)
+        .map(|(c, s)| c.point.bsdf(s))
+        .collect();
     for (k, (case, scene)) in cases.iter().zip(&scenes).enumerate() {
         let sp = case.point.shading_point(scene, &bsdfs[k]).ok_or_else(|| {
             Error::Usage(format!("stress case {}: the traced ray misses", case.name))
