@@ -2,6 +2,7 @@
 
 pub mod compare;
 pub mod crosscheck;
+pub mod options;
 pub mod rays;
 pub mod raysets;
 pub mod reference;

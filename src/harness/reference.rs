@@ -15,7 +15,7 @@ use crate::render::Renderer;
 use crate::strategy::{Integrand, reference_strategy};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ReferenceMeta {
@@ -37,6 +37,20 @@ pub struct ReferenceMeta {
     pub noise_floor_rmse: Option<f64>,
     pub dibench_version: String,
     pub commit: String,
+}
+
+/// How a reference was rendered, as `dibench reference` prints it after the file's path.
+impl std::fmt::Display for ReferenceMeta {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} spp, {:.1} s, strategy {}, noise floor {:.3e} RMSE",
+            self.spp,
+            self.wall_time_s,
+            self.strategy,
+            self.noise_floor_rmse.unwrap_or(0.0)
+        )
+    }
 }
 
 pub fn reference_dir(out: &Path, scene: &str) -> PathBuf {
@@ -109,16 +123,11 @@ pub fn render_progressive(
     checkpoints: Option<&Locked>,
 ) -> Result<Rendered> {
     let (spp, time) = match budget {
-        Budget::Spp(0) => return Err(Error::Usage("--spp must be at least 1".into())),
-        Budget::Spp(n) => (n, None),
-        Budget::Time(t) => match Duration::try_from_secs_f64(t) {
-            Ok(d) if d > Duration::ZERO => (u64::MAX, Some(d)),
-            _ => {
-                return Err(Error::Usage(format!(
-                    "--time must be a positive number of seconds, got {t}"
-                )));
-            }
-        },
+        Budget::Spp(n) => {
+            super::options::check_at_least_one("--spp", n)?;
+            (n, None)
+        }
+        Budget::Time(t) => (u64::MAX, Some(super::options::check_seconds("--time", t)?)),
     };
     let strategy = strategy_for(scene, integrand)?;
     let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
