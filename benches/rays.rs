@@ -98,13 +98,19 @@ fn build_sweep() {
                     ..BuildParams::default()
                 };
                 let tr = PacketTracer::build_with(scene.world.geometry.clone(), isa, &p).unwrap();
-                println!("{name} {pname} block_cost {block_cost}: {}", tr.wide().describe());
+                println!(
+                    "{name} {pname} block_cost {block_cost}: {}",
+                    tr.wide().describe()
+                );
                 labels.push(format!("{pname}/{block_cost}"));
                 subjects.push(Subject::Packet(tr));
             }
         }
         let rows = measure(name, &sets, &subjects, 7, 1);
-        println!("build sweep, {name}, {}: Mrays/s per (preset/block cost)", isa.name());
+        println!(
+            "build sweep, {name}, {}: Mrays/s per (preset/block cost)",
+            isa.name()
+        );
         for set in &sets {
             let line: Vec<String> = rows
                 .iter()

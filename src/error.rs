@@ -18,8 +18,18 @@ pub enum Error {
         field: String,
         message: String,
     },
+    /// Bad use of the command line or of a library entry point: an unknown name, a value out
+    /// of range, options that do not go together.
     #[error("{0}")]
     Usage(String),
+    /// A check that ran and failed: a cross-check disagreement, a stress failure, a χ² test
+    /// below its significance level.
+    #[error("{0}")]
+    Check(String),
+    /// A tracer backend that cannot be built or used here: Embree not compiled in or failing,
+    /// an ISA this CPU lacks, a BVH the packet backend cannot hold.
+    #[error("{0}")]
+    Backend(String),
     #[error("{path}: {message}")]
     Output { path: PathBuf, message: String },
     /// A size or count from a flag or a file that would need more memory than there is,
@@ -51,6 +61,16 @@ impl Error {
             path: path.into(),
             field: field.into(),
             message: message.into(),
+        }
+    }
+
+    /// The same kind of error with `prefix: ` before its message (a usage error for kinds
+    /// without a plain message).
+    pub fn prefixed(self, prefix: &str) -> Self {
+        match self {
+            Error::Check(m) => Error::Check(format!("{prefix}: {m}")),
+            Error::Backend(m) => Error::Backend(format!("{prefix}: {m}")),
+            e => Error::Usage(format!("{prefix}: {e}")),
         }
     }
 

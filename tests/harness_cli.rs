@@ -496,3 +496,45 @@ fn an_interrupted_reference_keeps_the_better_stored_one() {
         assert!(stderr.contains("no checkpoint of it stored"), "{stderr}");
     }
 }
+
+/// The exit status tells the kind of error (`cli::exit_status`): 1 for a usage error found
+/// after parsing, 2 for a command line the parser refuses, 3 for a check that ran and failed,
+/// 4 for a backend that cannot be used here.
+#[test]
+fn exit_statuses_tell_the_kind_of_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, stdout, stderr) = dibench(
+        &["warp", "phong-lecture", "--samples", "100000"],
+        dir.path(),
+    );
+    assert_eq!(code, 3, "{stderr}");
+    assert!(
+        stdout.contains("χ² =") && stderr.contains("FAILED"),
+        "{stdout}{stderr}"
+    );
+    let (code, _, stderr) = dibench(&["warp", "no-such-sampler"], dir.path());
+    assert_eq!(code, 1, "{stderr}");
+    let (code, _, stderr) = dibench(&["warp", "phong-lecture", "--alpha", "2"], dir.path());
+    assert_eq!(code, 2, "{stderr}");
+    if !cfg!(feature = "embree") {
+        let (code, _, stderr) = dibench(
+            &[
+                "reference",
+                "cornell",
+                "--backend",
+                "embree",
+                "--out",
+                "out",
+            ],
+            dir.path(),
+        );
+        assert_eq!(code, 4, "{stderr}");
+        assert!(stderr.contains("--features embree"), "{stderr}");
+    }
+    let (code, _, stderr) = dibench(
+        &["reference", "cornell", "--backend", "magic", "--out", "out"],
+        dir.path(),
+    );
+    assert_eq!(code, 1, "{stderr}");
+    assert!(!dir.path().join("out").exists());
+}

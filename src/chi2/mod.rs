@@ -116,6 +116,17 @@ pub struct Chi2Result {
     pub histogram: Histogram,
 }
 
+/// The line `dibench warp` prints: statistic, degrees of freedom, p-value and sample count.
+impl std::fmt::Display for Chi2Result {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}: χ² = {:.1}, dof = {}, p = {:.4e} ({} samples)",
+            self.label, self.chi2, self.dof, self.p_value, self.samples
+        )
+    }
+}
+
 impl Chi2Result {
     pub fn passes(&self, alpha: f64) -> bool {
         self.hard_failure.is_none() && self.p_value >= alpha

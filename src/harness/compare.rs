@@ -35,6 +35,16 @@ pub struct CompareOptions {
     pub isa: String,
 }
 
+impl CompareOptions {
+    /// The bounds `compare::run` needs (`harness::options`; the command line checks the same
+    /// ones as it parses).
+    pub fn check(&self) -> Result<()> {
+        super::options::check_seconds("--time", self.time_s)?;
+        super::options::check_at_least_one("--runs", self.runs as u64)?;
+        super::options::check_seeds(self.seed, self.runs)
+    }
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ResultRow {
     pub scene: String,
@@ -174,6 +184,103 @@ pub struct CompareReport {
     pub rows: Vec<ResultRow>,
     pub summary: Vec<SummaryRow>,
     pub skipped: Vec<Skipped>,
+    /// What the run was, for the printed summary.
+    pub scene: String,
+    pub backend: String,
+    pub threads: usize,
+    pub seed: u64,
+    pub time_s: f64,
+    pub references: Vec<ReferenceUsed>,
+}
+
+/// A reference a compare run measured against.
+#[derive(Clone, Debug)]
+pub struct ReferenceUsed {
+    pub integrand: String,
+    pub spp: u64,
+    pub noise_floor: Option<f64>,
+}
+
+/// The summary `dibench compare` prints: the run's setting, a row per (strategy, integrand),
+/// the largest deviation from the budget and the references' noise floors.
+impl std::fmt::Display for CompareReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let spp: Vec<String> = self
+            .references
+            .iter()
+            .map(|r| format!("{} {} spp", r.integrand, r.spp))
+            .collect();
+        writeln!(
+            f,
+            "scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {}",
+            self.scene,
+            self.backend,
+            self.threads,
+            self.seed,
+            self.time_s,
+            spp.join(", ")
+        )?;
+        let overshoot = self
+            .summary
+            .iter()
+            .map(|r| r.overshoot_max)
+            .fold(f64::NEG_INFINITY, f64::max);
+        writeln!(
+            f,
+            "largest deviation from the budget: {:+.2} % (a run stops at the last whole pass predicted to fit)",
+            100.0 * overshoot
+        )?;
+        for r in &self.references {
+            if let Some(floor) = r.noise_floor {
+                writeln!(
+                    f,
+                    "reference ({}) noise floor: {floor:.3e} RMSE; the debiased columns subtract it",
+                    r.integrand
+                )?;
+            }
+        }
+        writeln!(f, "results: {}", self.run_dir.display())?;
+        // The table last, ranked by the debiased relMSE (see `summary`).
+        let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
+        let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
+        let opt_e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
+        writeln!(
+            f,
+            "{:<22} {:>9} {:>4} {:>8} {:>10} {:>9} {:>10} {:>10} {:>9} {:>6} {:>10} {:>10} vs_best (Holm)",
+            "strategy",
+            "integrand",
+            "runs",
+            "spp",
+            "rmse",
+            "±95%",
+            "rmse_deb",
+            "relmse_deb",
+            "±95%",
+            "slope",
+            "pred_rmse",
+            "efficiency",
+        )?;
+        for r in &self.summary {
+            writeln!(
+                f,
+                "{:<22} {:>9} {:>4} {:>8.0} {:>10.3e} {:>9} {:>10} {:>10.3e} {:>9} {:>6} {:>10.3e} {:>10.3e} {}",
+                r.strategy,
+                r.integrand,
+                r.runs,
+                r.spp_mean,
+                r.rmse_mean,
+                ci(r.rmse_ci95),
+                opt_e(r.rmse_debiased),
+                r.relmse_debiased_mean,
+                ci(r.relmse_debiased_ci95),
+                opt(r.slope_time_mean),
+                r.predicted_rmse,
+                r.efficiency,
+                r.vs_best
+            )?;
+        }
+        Ok(())
+    }
 }
 
 /// A reference image per integrand the compared strategies need.
@@ -336,15 +443,7 @@ pub fn run(
     run_dir: &RunDir,
     opts: &CompareOptions,
 ) -> Result<CompareReport> {
-    if !(opts.time_s.is_finite() && opts.time_s > 0.0) {
-        return Err(Error::Usage(format!(
-            "--time must be a positive number of seconds, got {}",
-            opts.time_s
-        )));
-    }
-    if opts.runs == 0 {
-        return Err(Error::Usage("--runs must be at least 1".into()));
-    }
+    opts.check()?;
     if strategies.is_empty() {
         return Err(Error::Usage(format!(
             "scene `{}`: no strategy applies",
@@ -447,5 +546,19 @@ pub fn run(
         rows,
         summary,
         skipped,
+        scene: scene.scene.name.clone(),
+        backend: scene.tracer.name().to_string(),
+        threads: opts.threads,
+        seed: opts.seed,
+        time_s: opts.time_s,
+        references: references
+            .images
+            .iter()
+            .map(|r| ReferenceUsed {
+                integrand: r.integrand.name().to_string(),
+                spp: r.spp,
+                noise_floor: r.noise_floor,
+            })
+            .collect(),
     })
 }

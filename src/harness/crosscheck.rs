@@ -69,6 +69,58 @@ pub struct Report {
     pub failures: Vec<String>,
 }
 
+/// The table `dibench crosscheck` prints: a line per (set, backend, mode) or render
+/// comparison, then where the CSV is.
+impl std::fmt::Display for Report {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(
+            f,
+            "{:<12} {:<8} {:<9} {:>7} {:>6} {:>6} {:>5} {:>9} {:>6} {:>9} {:>8}",
+            "set",
+            "backend",
+            "mode",
+            "rays",
+            "hitMM",
+            "primMM",
+            "ties",
+            "t_rel",
+            "occMM",
+            "seconds",
+            "Mrays/s"
+        )?;
+        for r in &self.rows {
+            if let Some(d) = r.image_rel_rmse {
+                writeln!(
+                    f,
+                    "{:<12} {:<8} {:<9} image relative RMSE vs obvhs {d:.3e} {}",
+                    r.set,
+                    r.backend,
+                    r.mode,
+                    if r.pass { "ok" } else { "FAIL" }
+                )?;
+                continue;
+            }
+            writeln!(
+                f,
+                "{:<12} {:<8} {:<9} {:>7} {:>6} {:>6} {:>5} {:>9.2e} {:>6} {:>9.4} {:>8.2}{}",
+                r.set,
+                r.backend,
+                r.mode,
+                r.rays,
+                r.hit_mismatch,
+                r.prim_mismatch,
+                r.ties,
+                r.t_rel_max,
+                r.occlusion_mismatch,
+                r.seconds,
+                r.mrays_per_s,
+                if r.pass { "" } else { "  FAIL" }
+            )?;
+        }
+        writeln!(f, "results: {}", self.csv.display())
+    }
+}
+
 /// Closest hits and occlusion of every ray of a set, single-ray or as 16-packets.
 pub struct Traced {
     pub hits: Vec<Option<Hit>>,
@@ -361,7 +413,7 @@ pub fn into_result(report: &Report) -> Result<()> {
     if report.failures.is_empty() {
         Ok(())
     } else {
-        Err(Error::Usage(format!(
+        Err(Error::Check(format!(
             "crosscheck failed ({} checks below threshold):\n  {}",
             report.failures.len(),
             report.failures.join("\n  ")

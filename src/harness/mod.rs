@@ -2,6 +2,7 @@
 
 pub mod compare;
 pub mod crosscheck;
+pub mod options;
 pub mod pilot;
 pub mod rays;
 pub mod raysets;

@@ -12,6 +12,7 @@ use crate::tracer::packet::{PacketTracer, TraceStats};
 use crate::tracer::{HitPacket, LaneMask, RayPacket, Tracer};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -169,6 +170,75 @@ fn trace_embree(
 
 pub fn unknown_backend(name: &str) -> Error {
     backends::unknown(name)
+}
+
+/// What `dibench rays` measured: its setting, a row per (backend, ISA, ray class), and where
+/// the CSV is.
+pub struct RaysReport {
+    pub scene: String,
+    pub threads: usize,
+    pub size: u32,
+    pub rounds: usize,
+    pub rows: Vec<RaysRow>,
+    pub csv: PathBuf,
+}
+
+/// The table `dibench rays` prints, with our best packet path against Embree's best kernel
+/// per ray class where both ran (the bar to steer by).
+impl std::fmt::Display for RaysReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let rows = &self.rows;
+        writeln!(
+            f,
+            "scene {} · {} threads · {}x{} rays per class · best of {} rounds",
+            self.scene, self.threads, self.size, self.size, self.rounds
+        )?;
+        writeln!(
+            f,
+            "{:<8} {:<9} {:<15} {:>8} {:>9} {:>10} {:>8} {:>8} {:>8}",
+            "backend",
+            "isa",
+            "ray_class",
+            "rays",
+            "Mrays/s",
+            "x obvhs",
+            "lanes",
+            "nodes/r",
+            "tests/r"
+        )?;
+        let opt = |x: Option<f64>, p: usize| x.map_or("-".to_string(), |v| format!("{v:.p$}"));
+        for r in rows {
+            writeln!(
+                f,
+                "{:<8} {:<9} {:<15} {:>8} {:>9.2} {:>10} {:>8} {:>8} {:>8}",
+                r.backend,
+                r.isa,
+                r.ray_class,
+                r.rays,
+                r.mrays_per_s,
+                opt(r.ratio_to_obvhs, 2),
+                opt(r.active_lane_fraction, 2),
+                opt(r.nodes_per_ray, 1),
+                opt(r.tests_per_ray, 1)
+            )?;
+        }
+        for class in rows
+            .iter()
+            .map(|r| r.ray_class.clone())
+            .collect::<std::collections::BTreeSet<_>>()
+        {
+            let best = |b: &str| {
+                rows.iter()
+                    .filter(|r| r.ray_class == class && r.backend == b)
+                    .map(|r| r.mrays_per_s)
+                    .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))))
+            };
+            if let (Some(ours), Some(embree)) = (best("packet"), best("embree")) {
+                writeln!(f, "packet/embree {class:<15} {:.2}", ours / embree)?;
+            }
+        }
+        writeln!(f, "results: {}", self.csv.display())
+    }
 }
 
 #[derive(Clone, Debug, Serialize)]

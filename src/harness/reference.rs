@@ -39,6 +39,20 @@ pub struct ReferenceMeta {
     pub commit: String,
 }
 
+/// How a reference was rendered, as `dibench reference` prints it after the file's path.
+impl std::fmt::Display for ReferenceMeta {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} spp, {:.1} s, strategy {}, noise floor {:.3e} RMSE",
+            self.spp,
+            self.wall_time_s,
+            self.strategy,
+            self.noise_floor_rmse.unwrap_or(0.0)
+        )
+    }
+}
+
 pub fn reference_dir(out: &Path, scene: &str) -> PathBuf {
     out.join(scene).join("reference")
 }
@@ -117,13 +131,13 @@ pub fn render_progressive(
     checkpoints: Option<&Locked>,
 ) -> Result<Rendered> {
     match budget {
-        Budget::Spp(0) => return Err(Error::Usage("--spp must be at least 1".into())),
-        Budget::Time(t) if !Duration::try_from_secs_f64(t).is_ok_and(|d| d > Duration::ZERO) => {
-            return Err(Error::Usage(format!(
-                "--time must be a positive number of seconds, got {t}"
-            )));
+        Budget::Spp(n) => super::options::check_at_least_one("--spp", n)?,
+        Budget::Time(t) => {
+            super::options::check_seconds("--time", t)?;
         }
-        _ => {}
+        Budget::Floor { cap, .. } => {
+            super::options::check_seconds("--reference-cap", cap)?;
+        }
     }
     let strategy = strategy_for(scene, integrand)?;
     render_with(scene, strategy.as_ref(), budget, seed, threads, checkpoints)

@@ -88,9 +88,7 @@ pub fn render(
     seed: u64,
     spec: ShardSpec,
 ) -> Result<(Film, ShardMeta)> {
-    if total_spp == 0 {
-        return Err(Error::Usage("--spp must be at least 1".into()));
-    }
+    super::options::check_at_least_one("--spp", total_spp)?;
     let strategy = strategy_for(scene, integrand)?;
     let mut renderer = Renderer::new(scene, strategy.as_ref(), reference_stream_seed(seed))?;
     let mut film = Film::new(scene.scene.width, scene.scene.height);

@@ -42,9 +42,7 @@ impl Isa {
     /// The best supported ISA, unless `DIBENCH_ISA` names one.
     pub fn detect() -> Result<Isa> {
         match std::env::var("DIBENCH_ISA") {
-            Ok(s) if !s.is_empty() => {
-                Isa::parse(&s).map_err(|e| Error::Usage(format!("DIBENCH_ISA: {e}")))
-            }
+            Ok(s) if !s.is_empty() => Isa::parse(&s).map_err(|e| e.prefixed("DIBENCH_ISA")),
             _ => Ok(Isa::available()[0]),
         }
     }
@@ -59,7 +57,7 @@ impl Isa {
             })?;
         if !isa.supported() {
             let have: Vec<_> = Isa::available().iter().map(|i| i.name()).collect();
-            return Err(Error::Usage(format!(
+            return Err(Error::Backend(format!(
                 "ISA `{s}` is not supported by this CPU (available: {})",
                 have.join(", ")
             )));

@@ -17,7 +17,7 @@ use crate::strategy::{Integrand, ShadingPoint, Strategy, applicable};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Chance that a correct suite run reports any false unbiasedness failure.
 pub const FAMILY_ALPHA: f64 = 1e-3;
@@ -332,6 +332,99 @@ fn judge(
         );
     }
     row
+}
+
+/// What `dibench stress` ran and found: its setting, a row per (case, strategy), and where
+/// the CSV is.
+pub struct Report {
+    /// The cases run, in order (names).
+    pub cases: Vec<String>,
+    pub samples: u64,
+    pub seed: u64,
+    pub threads: usize,
+    pub rows: Vec<StressRow>,
+    pub csv: PathBuf,
+}
+
+impl Report {
+    /// The checks with status `s`.
+    pub fn count(&self, s: Status) -> usize {
+        self.rows.iter().filter(|r| r.status == s).count()
+    }
+}
+
+/// The tables `dibench stress` prints: every row, a line per case, the totals.
+impl std::fmt::Display for Report {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let rows = &self.rows;
+        writeln!(
+            f,
+            "{} cases · {} samples per strategy · seed {} · {} threads",
+            self.cases.len(),
+            self.samples,
+            self.seed,
+            self.threads
+        )?;
+        writeln!(
+            f,
+            "{:<24} {:<20} {:>5} {:>9} {:>12} {:>12} {:>7} {:>10}  status",
+            "case", "strategy", "bad", "ess", "mean", "expected", "z", "rel.var"
+        )?;
+        let opt = |x: Option<f64>, g: &dyn Fn(f64) -> String| x.map_or("-".to_string(), g);
+        for r in rows {
+            writeln!(
+                f,
+                "{:<24} {:<20} {:>5} {:>9.0} {:>12.5e} {:>12} {:>7} {:>10}  {:?}{}{}",
+                r.case,
+                r.strategy,
+                r.nan + r.inf + r.negative,
+                r.effective_samples,
+                r.mean,
+                opt(r.expected, &|v| format!("{v:.5e}")),
+                opt(r.z, &|v| format!("{v:.2}")),
+                opt(r.rel_variance, &|v| format!("{v:.3e}")),
+                r.status,
+                if r.detail.is_empty() { "" } else { ": " },
+                r.detail
+            )?;
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "{:<24} {:>4} {:>4} {:>10} {:>4} {:>9}  lowest relative variance",
+            "case", "runs", "pass", "unresolved", "fail", "nonfinite"
+        )?;
+        for name in &self.cases {
+            let of: Vec<_> = rows.iter().filter(|r| &r.case == name).collect();
+            let n = |s: Status| of.iter().filter(|r| r.status == s).count();
+            let best = of
+                .iter()
+                .filter(|r| r.status == Status::Pass)
+                .filter_map(|r| r.rel_variance.map(|v| (v, &r.strategy)))
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .map_or("-".to_string(), |(v, s)| format!("{s} {v:.2e}"));
+            writeln!(
+                f,
+                "{:<24} {:>4} {:>4} {:>10} {:>4} {:>9}  {best}",
+                name,
+                of.iter().filter(|r| r.samples > 0).count(),
+                n(Status::Pass),
+                n(Status::Unresolved),
+                n(Status::Fail),
+                of.iter().map(|r| r.nan + r.inf + r.negative).sum::<u64>(),
+            )?;
+        }
+        let bad: u64 = rows.iter().map(|r| r.nan + r.inf + r.negative).sum();
+        writeln!(
+            f,
+            "{} checks: {} pass, {} unresolved, {} fail; {bad} non-finite or negative samples",
+            rows.len(),
+            self.count(Status::Pass),
+            self.count(Status::Unresolved),
+            self.count(Status::Fail)
+        )?;
+        writeln!(f, "results: {}", self.csv.display())
+    }
 }
 
 /// Runs the suite on `cases` with `samples` per (case, strategy); pairs run in parallel, each

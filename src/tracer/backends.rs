@@ -45,9 +45,10 @@ pub fn build_isa(name: &str, geometry: Arc<Geometry>, isa: Option<Isa>) -> Resul
     }
 }
 
-/// The error for a backend name that is not compiled in, listing the available ones.
+/// The error for a backend name that is not compiled in, listing the available ones: a
+/// backend error for `embree` built without it, a usage error for any other name.
 pub fn unknown(name: &str) -> Error {
-    Error::Usage(format!(
+    let message = format!(
         "unknown backend `{name}` (available: {}{})",
         AVAILABLE.join(", "),
         if cfg!(feature = "embree") {
@@ -55,7 +56,12 @@ pub fn unknown(name: &str) -> Error {
         } else {
             "; `embree` needs scripts/setup-embree.sh and --features embree"
         }
-    ))
+    );
+    if name == "embree" {
+        Error::Backend(message)
+    } else {
+        Error::Usage(message)
+    }
 }
 
 /// Checks a backend name without building anything.

@@ -41,9 +41,10 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    /// An ordinary end: success, or a reported error (exit 1 or clap's 2), or 130 after Ctrl-C.
+    /// An ordinary end: success, or a reported error (exit 1, clap's 2, 3 for a failed check,
+    /// 4 for an unusable backend: `cli::exit_status`), or 130 after Ctrl-C.
     pub fn ended_cleanly(&self) -> bool {
-        matches!(self.code, Some(0 | 1 | 2 | 130))
+        matches!(self.code, Some(0..=4 | 130))
     }
 }
 

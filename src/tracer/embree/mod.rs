@@ -206,7 +206,7 @@ impl EmbreeTracer {
         unsafe {
             let device = ffi::rtcNewDevice(std::ptr::null());
             if device.is_null() {
-                return Err(Error::Usage(format!(
+                return Err(Error::Backend(format!(
                     "Embree: cannot create a device (error code {})",
                     ffi::rtcGetDeviceError(std::ptr::null_mut())
                 )));
@@ -216,7 +216,7 @@ impl EmbreeTracer {
             let version = ffi::rtcGetDeviceProperty(device, ffi::RTC_DEVICE_PROPERTY_VERSION);
             if version < MIN_VERSION {
                 ffi::rtcReleaseDevice(device);
-                return Err(Error::Usage(format!(
+                return Err(Error::Backend(format!(
                     "Embree {version} is too old: dibench's FFI needs Embree >= 4.4.0 ({MIN_VERSION}); run scripts/setup-embree.sh"
                 )));
             }
@@ -254,7 +254,7 @@ impl EmbreeTracer {
             .unwrap_or_default();
         // SAFETY: the device handle is valid for the tracer's life.
         let code = unsafe { ffi::rtcGetDeviceError(self.device) };
-        Error::Usage(format!("Embree: {what} failed (code {code}) {msgs}"))
+        Error::Backend(format!("Embree: {what} failed (code {code}) {msgs}"))
     }
 
     fn check(&self, what: &str) -> Result<()> {

@@ -48,7 +48,7 @@ impl Child {
 
     fn inner(i: usize) -> Result<Child> {
         if i as u64 >= SPHERE as u64 {
-            return Err(Error::Usage(format!(
+            return Err(Error::Backend(format!(
                 "packet backend: {i} nodes exceed 2^30"
             )));
         }
@@ -58,7 +58,7 @@ impl Child {
     fn block(i: usize, count: usize) -> Result<Child> {
         debug_assert!((1..=BRANCH).contains(&count));
         if i as u64 > INDEX_BITS as u64 {
-            return Err(Error::Usage(format!(
+            return Err(Error::Backend(format!(
                 "packet backend: {i} leaf blocks exceed 2^27"
             )));
         }
@@ -67,7 +67,7 @@ impl Child {
 
     fn sphere(prim: u32) -> Result<Child> {
         if prim >= SPHERE {
-            return Err(Error::Usage(format!(
+            return Err(Error::Backend(format!(
                 "packet backend: primitive id {prim} exceeds 2^30"
             )));
         }
@@ -293,7 +293,7 @@ impl Collapser<'_> {
                 .iter()
                 .any(|&p| self.geometry.sphere_index(p).is_some())
         {
-            return Err(Error::Usage(
+            return Err(Error::Backend(
                 "packet backend: obvhs returned a leaf the collapse cannot store".into(),
             ));
         }

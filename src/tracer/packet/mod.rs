@@ -186,7 +186,7 @@ impl PacketTracer {
         let wide = Wide::build(&geometry, p)?;
         // Each level pushes at most BRANCH - 1 entries; a packet's node may push all BRANCH.
         if wide.depth * BRANCH + 1 > STACK {
-            return Err(Error::Usage(format!(
+            return Err(Error::Backend(format!(
                 "packet backend: BVH depth {} exceeds the traversal stack ({STACK} entries)",
                 wide.depth
             )));

@@ -1,0 +1,79 @@
+//! `dibench rays`: ray throughput of each backend (and ISA) on fixed ray sets.
+
+use super::{load, parse_threads, pool};
+use crate::error::Result;
+use crate::harness::rays;
+use crate::simd::Isa;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct RaysArgs {
+    /// Scene file, or the name of a scene in scenes/.
+    #[arg(default_value = "bunny")]
+    pub scene: String,
+    /// Output root; the table goes to <out>/<scene>/rays.csv.
+    #[arg(long, default_value = "results")]
+    pub out: PathBuf,
+    /// Comma-separated backends (obvhs, packet); packet runs at every available ISA.
+    #[arg(long, value_delimiter = ',', default_value = "obvhs,packet")]
+    pub backend: Vec<String>,
+    /// Only this ISA for the packet backend (default: every ISA the CPU has).
+    #[arg(long)]
+    pub isa: Option<String>,
+    /// Tracing threads (default 1: single-thread throughput).
+    #[arg(long, default_value_t = 1, value_parser = parse_threads, allow_negative_numbers = true)]
+    pub threads: usize,
+    /// Image side of the ray sets, in pixels.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=crate::scene::MAX_IMAGE_SIDE as i64), allow_negative_numbers = true)]
+    pub size: u32,
+    /// Timing rounds (best round is reported; order alternates between rounds).
+    #[arg(long, default_value_t = 5, value_parser = parse_rounds, allow_negative_numbers = true)]
+    pub rounds: usize,
+    #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+    pub seed: u64,
+}
+
+fn parse_rounds(s: &str) -> std::result::Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("expected a whole number from 1 to {}", usize::MAX)),
+    }
+}
+
+pub fn run(a: RaysArgs) -> Result<()> {
+    for b in &a.backend {
+        if !rays::BACKENDS.contains(&b.as_str()) {
+            return Err(rays::unknown_backend(b));
+        }
+    }
+    let isas = match (&a.isa, std::env::var("DIBENCH_ISA")) {
+        (Some(s), _) => vec![Isa::parse(s)?],
+        (None, Ok(s)) if !s.is_empty() => vec![Isa::detect()?],
+        _ => Isa::available(),
+    };
+    let (pool, threads) = pool(Some(a.threads))?;
+    let scene = load(&a.scene)?;
+    let name = scene.scene.name.clone();
+    let path = a.out.join(&name).join("rays.csv");
+    crate::output::check_output_dir(&a.out.join(&name), "--out")?;
+    // Four sets of size² rays, with their packets and masks: about 256 bytes per ray.
+    crate::bounded::check_memory(
+        || format!("--size {}", a.size),
+        crate::bounded::bytes(a.size as u64 * a.size as u64, 256),
+    )?;
+    let sets = rays::generate(&scene, a.size, a.seed);
+    let subjects = rays::subjects(&scene, &a.backend, &isas)?;
+    let rows = pool.install(|| rays::measure(&name, &sets, &subjects, a.rounds, threads));
+    crate::output::write_csv(&path, &rows)?;
+    let report = rays::RaysReport {
+        scene: name,
+        threads,
+        size: a.size,
+        rounds: a.rounds,
+        rows,
+        csv: path,
+    };
+    print!("{report}");
+    Ok(())
+}
