@@ -482,3 +482,43 @@ fn small_sphere_light_every_strategy() {
         );
     }
 }
+
+/// Conductor indices are bounded where the scene is read, and every accepted extreme gives a
+/// finite Fresnel reflectance in [0, 1] at every angle: an index outside (1e38, whose square overflows
+/// f32) is refused by name instead of rendering NaN.
+#[test]
+fn conductor_indices_are_bounded_and_their_fresnel_finite() {
+    use dibench::bsdf::fresnel::conductor;
+    for eta in [1e-3f32, 0.05, 1.0, 20.0, 1e3] {
+        for k in [0.0f32, 1e-3, 3.0, 1e3] {
+            for i in 0..=64 {
+                let c = i as f32 / 64.0;
+                let f = conductor(c, eta, k);
+                // 1 + 1e-6: total reflection (η < 1, κ = 0) is 1 up to f32 rounding.
+                assert!(
+                    (0.0..=1.0 + 1e-6).contains(&f),
+                    "F({c}; {eta} + {k}i) = {f}"
+                );
+            }
+        }
+    }
+    let header = "[camera]\neye = [0.0, 5.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_y_deg = 40.0\n\
+                  [image]\nwidth = 8\nheight = 8\n[[material]]\nname = \"m\"\ntype = \"ggx\"\n\
+                  roughness = 0.5\n";
+    let light = "[[point_light]]\nposition = [0.0, 1.0, 0.0]\npower = [1.0, 1.0, 1.0]\n\
+                 [[sphere]]\ncenter = [0.0, 0.0, 0.0]\nradius = 0.5\nmaterial = \"m\"\n";
+    let dir = tempfile::tempdir().unwrap();
+    for (eta, k, ok) in [
+        ("1e-3", "1e3", true),
+        ("1e38", "1e38", false),
+        ("1e-4", "0.0", false),
+        ("1.0", "-1.0", false),
+    ] {
+        let text = format!("{header}eta = [{eta}, {eta}, {eta}]\nk = [{k}, {k}, {k}]\n{light}");
+        let r = Scene::parse(&text, &dir.path().join("c.toml"));
+        assert_eq!(r.is_ok(), ok, "η {eta}, κ {k}: {:?}", r.err());
+        if let Err(e) = r {
+            assert!(e.to_string().contains("material[0].eta"), "{e}");
+        }
+    }
+}

@@ -89,10 +89,16 @@ fn debiased_errors_against_small_references_match_a_large_one() {
     }
     for (name, debiased, raw) in [("MSE", &d_mse, &raw_mse), ("relMSE", &d_rel, &raw_rel)] {
         let (m, se) = mean_se(debiased);
-        eprintln!("{name}: debiased − truth {m:.3e} ± {se:.3e}, raw − truth {:.3e}", mean_se(raw).0);
+        eprintln!(
+            "{name}: debiased − truth {m:.3e} ± {se:.3e}, raw − truth {:.3e}",
+            mean_se(raw).0
+        );
         assert!(m.abs() <= 4.0 * se, "debiased {name}: {m:.3e} ± {se:.3e}");
         let (m, se) = mean_se(raw);
-        assert!(m > 4.0 * se, "raw {name} should be biased: {m:.3e} ± {se:.3e}");
+        assert!(
+            m > 4.0 * se,
+            "raw {name} should be biased: {m:.3e} ± {se:.3e}"
+        );
     }
 }
 
@@ -149,7 +155,10 @@ fn the_default_compare_sizes_its_reference_and_ends_without_warning() {
     let floor: f64 = field(header, rows[0], "reference_noise_floor")
         .parse()
         .unwrap();
-    assert!(floor <= 0.3 * min_rmse, "floor {floor}, smallest RMSE {min_rmse}");
+    assert!(
+        floor <= 0.3 * min_rmse,
+        "floor {floor}, smallest RMSE {min_rmse}"
+    );
     for r in &rows {
         let slope: f64 = field(header, r, "slope_spp_mean").parse().unwrap();
         assert!((-0.62..=-0.38).contains(&slope), "{r}: slope {slope}");

@@ -108,6 +108,10 @@ impl C {
 /// cos θt = sqrt(1 − sin²θ/η²), r⊥ = (c − η cos θt)/(c + η cos θt),
 /// r∥ = (η c − cos θt)/(η c + cos θt), F = (|r⊥|² + |r∥|²)/2. At c = 0 both are −1: F = 1.
 pub fn conductor(c: f32, eta: f32, k: f32) -> f32 {
+    // A matched index is no interface: nothing is reflected (and at c = 0 both ratios are 0/0).
+    if eta == 1.0 && k == 0.0 {
+        return 0.0;
+    }
     let n = C::new(eta, k);
     let sin2 = C::new((1.0 - c * c).max(0.0), 0.0);
     let cos_t = C::new(1.0, 0.0).sub(sin2.div(n.mul(n))).sqrt();

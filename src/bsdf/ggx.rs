@@ -150,8 +150,14 @@ fn parse_fresnel(p: &mut Params) -> Result<Fresnel> {
     }
     match (eta, k) {
         (Some(eta), Some(k)) => {
-            if eta.min_element() <= 0.0 || k.min_element() < 0.0 {
-                return Err(p.error("eta", "need η > 0 and κ ≥ 0 per channel"));
+            // Real conductors have η, κ of order 0.01–20; the bounds keep |η + iκ|² and its
+            // inverse finite in f32, so the Fresnel equations can never overflow.
+            let ok = |v: glam::Vec3, lo: f32| v.min_element() >= lo && v.max_element() <= 1e3;
+            if !ok(eta, 1e-3) || !ok(k, 0.0) {
+                return Err(p.error(
+                    "eta",
+                    "need 1e-3 ≤ η ≤ 1e3 and 0 ≤ κ ≤ 1e3 per channel",
+                ));
             }
             Ok(Fresnel::Conductor { eta, k })
         }

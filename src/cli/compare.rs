@@ -103,7 +103,9 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
                     .map(|s| pilot::pilot(&scene, s.as_ref(), a.common.seed, each))
                     .collect::<Result<Vec<_>>>()?;
                 if crate::interrupt::requested() {
-                    return Err(Error::Interrupted("compare stopped during the pilot".into()));
+                    return Err(Error::Interrupted(
+                        "compare stopped during the pilot".into(),
+                    ));
                 }
                 pilot::plan(&pilots, a.time, a.reference_floor)
             }
@@ -152,8 +154,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         };
         let report = compare::run(&scene, &run, skipped, &references, &run_dir, &opts)?;
         // The warnings, then the report, whose ranked table comes last.
-        for w in crate::harness::summary::noise_floor_warnings(&report.summary, a.reference_floor)
-        {
+        for w in crate::harness::summary::noise_floor_warnings(&report.summary, a.reference_floor) {
             eprintln!("{w}");
         }
         print!("{report}");

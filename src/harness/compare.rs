@@ -263,7 +263,7 @@ impl std::fmt::Display for CompareReport {
         for r in &self.summary {
             writeln!(
                 f,
-                "{:<22} {:>9} {:>4} {:>8.0} {:>10.3e} {:>9} {:>10} {:>10.3e} {:>9} {:>6} {:>10.3e} {:>10.3e} {}",
+                "{:<22} {:>9} {:>4} {:>8.0} {:>10.3e} {:>9} {:>10} {:>10.3e} {:>9} {:>6} {:>10.3e} {:>10} {}",
                 r.strategy,
                 r.integrand,
                 r.runs,
@@ -275,7 +275,7 @@ impl std::fmt::Display for CompareReport {
                 ci(r.relmse_debiased_ci95),
                 opt(r.slope_time_mean),
                 r.predicted_rmse,
-                r.efficiency,
+                opt_e(r.efficiency),
                 r.vs_best
             )?;
         }
@@ -331,12 +331,13 @@ impl Reference {
             Need::Spp(n) => n,
             Need::Floor { .. } => 1,
         };
-        let stored = reference::load_matching(&unit, scene, min_spp)?.filter(|(_, meta)| match &need {
-            Need::Spp(_) => true,
-            Need::Floor { plan, .. } => meta
-                .noise_floor_rmse
-                .is_some_and(|f| f <= plan.target_floor),
-        });
+        let stored =
+            reference::load_matching(&unit, scene, min_spp)?.filter(|(_, meta)| match &need {
+                Need::Spp(_) => true,
+                Need::Floor { plan, .. } => meta
+                    .noise_floor_rmse
+                    .is_some_and(|f| f <= plan.target_floor),
+            });
         let (image, meta, variance) = match stored {
             Some(r) => {
                 eprintln!(
@@ -528,7 +529,10 @@ pub fn run(
                 reference.noise_floor,
                 reference.relmse_floor,
             ) else {
-                return Err(Error::Usage(format!("`{}` (run {run}) left no rows", s.name())));
+                return Err(Error::Usage(format!(
+                    "`{}` (run {run}) left no rows",
+                    s.name()
+                )));
             };
             finals.push(last);
             rows.extend(r.rows);

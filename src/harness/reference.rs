@@ -168,7 +168,11 @@ pub fn render_with(
     };
     let mut renderer = Renderer::new(scene, strategy, reference_stream_seed(seed))?;
     let bar = progress_bar(
-        if time.is_some() && floor.is_none() { 0 } else { spp },
+        if time.is_some() && floor.is_none() {
+            0
+        } else {
+            spp
+        },
         format!("reference {} {}", scene.scene.name, integrand.name()),
         "{prefix} [{bar:30}] {pos}/{len} spp, eta {eta}",
     );
@@ -212,7 +216,7 @@ pub fn render_with(
             (Some(target), Some(cap)) => {
                 film.spp >= super::pilot::MIN_PASSES
                     && (start.elapsed() >= cap
-                        || (film.spp % 8 == 0 && noise_floor(&film) <= target))
+                        || (film.spp.is_multiple_of(8) && noise_floor(&film) <= target))
             }
             (_, Some(t)) => film.spp > 0 && start.elapsed() >= t,
             (_, None) => film.spp >= spp,

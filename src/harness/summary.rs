@@ -101,8 +101,8 @@ pub struct SummaryRow {
     pub relmse_debiased_mean: f64,
     pub relmse_debiased_ci95: Option<f64>,
     /// Veach's efficiency 1 / (relMSE · t), with the mean relMSE and mean time (the raw relMSE:
-    /// the debiased one may be zero or negative).
-    pub efficiency: f64,
+    /// the debiased one may be zero or negative); empty when the relMSE is 0 (an exact image).
+    pub efficiency: Option<f64>,
     /// √(σ² · (t/spp) / T + floor²): the RMSE expected from the per-sample variance σ², the
     /// measured cost per sample t/spp and the budget T, plus the reference's noise floor.
     pub predicted_rmse: f64,
@@ -138,9 +138,8 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
             .filter(|f| (f.row.integrand.as_str(), f.row.strategy.as_str()) == *k)
             .collect()
     };
-    let debiased = |k: &(&str, &str)| -> Vec<f64> {
-        group(k).iter().map(|f| f.relmse_debiased()).collect()
-    };
+    let debiased =
+        |k: &(&str, &str)| -> Vec<f64> { group(k).iter().map(|f| f.relmse_debiased()).collect() };
     let mut rows: Vec<SummaryRow> = keys
         .iter()
         .map(|k| {
@@ -184,7 +183,7 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
                 relmse_ci95: relmse.half_width,
                 relmse_debiased_mean: relmse_d.mean,
                 relmse_debiased_ci95: relmse_d.half_width,
-                efficiency: 1.0 / (relmse.mean * time.mean),
+                efficiency: (relmse.mean > 0.0).then(|| 1.0 / (relmse.mean * time.mean)),
                 predicted_rmse: predicted.iter().sum::<f64>() / predicted.len() as f64,
                 reference_noise_floor: floor,
                 slope_time_mean: slope_t.as_ref().map(|m| m.mean),
@@ -340,7 +339,7 @@ mod tests {
         assert!((get("a").relmse_mean - 1.0).abs() < 1e-12);
         // predicted √(σ²·c/T + floor²) with σ² = 0.01, c = 0.01 s, T = 1 s.
         assert!((get("a").predicted_rmse - (1e-4f64 + 1e-6).sqrt()).abs() < 1e-12);
-        assert!((get("a").efficiency - 1.0).abs() < 1e-12);
+        assert!((get("a").efficiency.unwrap() - 1.0).abs() < 1e-12);
         assert!(noise_floor_warnings(&rows, 0.1).is_empty());
     }
 
@@ -381,7 +380,10 @@ mod tests {
         eprintln!("family-wise error rate: Holm {holm}, uncorrected {raw}");
         // 3σ of a binomial rate 0.05 over 1000 families: 0.021.
         assert!(holm <= 0.05 + 0.021, "Holm FWER {holm}");
-        assert!(raw > 0.15, "uncorrected FWER {raw}: the simulation cannot see the correction");
+        assert!(
+            raw > 0.15,
+            "uncorrected FWER {raw}: the simulation cannot see the correction"
+        );
     }
 
     /// A run whose RMSE falls as c·t^(-1/2) and c·n^(-1/2) has slopes −½ exactly; one with a

@@ -72,14 +72,31 @@ fn curves(rows: &[ResultRow]) -> Vec<Curve> {
                     (t, ci.mean, ci.half_width)
                 })
                 .collect();
-            Curve {
-                label: if integrand == "direct" {
-                    strategy
-                } else {
-                    format!("{strategy} ({integrand})")
-                },
-                points,
-            }
+            // The mean over runs of each run's log-log slope (`summary::convergence_slopes`).
+            let mut runs: Vec<u32> = mine.iter().map(|r| r.run).collect();
+            runs.sort_unstable();
+            runs.dedup();
+            let slopes: Vec<f64> = runs
+                .iter()
+                .filter_map(|&k| {
+                    let of_run: Vec<ResultRow> = mine
+                        .iter()
+                        .filter(|r| r.run == k)
+                        .map(|r| (*r).clone())
+                        .collect();
+                    crate::harness::summary::convergence_slopes(&of_run).0
+                })
+                .collect();
+            let name = if integrand == "direct" {
+                strategy
+            } else {
+                format!("{strategy} ({integrand})")
+            };
+            let label = match slopes.len() {
+                0 => name,
+                n => format!("{name}, slope {:.2}", slopes.iter().sum::<f64>() / n as f64),
+            };
+            Curve { label, points }
         })
         .collect()
 }

@@ -93,7 +93,10 @@ impl Strategy for Mis {
             (Some(e), h) => format!("mis-{}-env-{}", h.name(), env_method_name(e)),
             (None, h) => format!("mis-{}", h.name()),
         };
-        with_selector(format!("{base}{}", self.sampling.name_suffix()), self.selector)
+        with_selector(
+            format!("{base}{}", self.sampling.name_suffix()),
+            self.selector,
+        )
     }
 
     fn describe(&self) -> String {
