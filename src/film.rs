@@ -194,7 +194,17 @@ mod tests {
     /// exact has exactly its value as the mean (sum / n, not sum · (1/n): 12·49 · (1/49) ≠ 12).
     #[test]
     fn constant_pixels_have_non_negative_variance_and_exact_mean() {
-        for &x in &[12.0f64, 17.0, 0.5, 1.75, 0.1, 1.0 / 3.0, 1.7, 123.456, 1e-30] {
+        for &x in &[
+            12.0f64,
+            17.0,
+            0.5,
+            1.75,
+            0.1,
+            1.0 / 3.0,
+            1.7,
+            123.456,
+            1e-30,
+        ] {
             let mut film = Film::new(1, 1);
             let i = film.layout.index(0, 0);
             for n in 0..8192u64 {

@@ -538,3 +538,24 @@ fn exit_statuses_tell_the_kind_of_error() {
     assert_eq!(code, 1, "{stderr}");
     assert!(!dir.path().join("out").exists());
 }
+
+/// `warp`'s verdict re-tests a failed χ² once, independently with 4× the samples: a correct
+/// sampler that fails at one seed by chance (`env-octa-cdf`, seed 1: p = 5.1e-3 < 0.01)
+/// passes, and a wrong one (`phong-lecture`) still fails, naming both p-values.
+#[test]
+fn warp_retests_before_it_says_failed() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, stdout, stderr) = dibench(&["warp", "env-octa-cdf", "--seed", "1"], dir.path());
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    assert!(stdout.contains("re-testing"), "{stdout}");
+    assert!(
+        stdout.contains("passed at alpha = 0.01 on the re-test"),
+        "{stdout}"
+    );
+    let (code, _, stderr) = dibench(
+        &["warp", "phong-lecture", "--samples", "100000"],
+        dir.path(),
+    );
+    assert_eq!(code, 3, "{stderr}");
+    assert!(stderr.contains("at 100000 samples and p ="), "{stderr}");
+}

@@ -114,25 +114,23 @@ fn field<'a>(header: &'a str, row: &'a str, name: &str) -> &'a str {
 fn the_default_compare_sizes_its_reference_and_ends_without_warning() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
-    let (code, stdout, stderr) = dibench(
-        &[
-            "compare",
-            "tiny.toml",
-            "--time",
-            "0.1",
-            "--runs",
-            "3",
-            "--reference-floor",
-            "0.3",
-            "--strategies",
-            "light,cosine,mis-power",
-            "--threads",
-            "1",
-            "--out",
-            "out",
-        ],
-        dir.path(),
-    );
+    let args = [
+        "compare",
+        "tiny.toml",
+        "--time",
+        "0.1",
+        "--runs",
+        "3",
+        "--reference-floor",
+        "0.3",
+        "--strategies",
+        "light,cosine,mis-power",
+        "--threads",
+        "1",
+        "--out",
+        "out",
+    ];
+    let (code, stdout, stderr) = dibench(&args, dir.path());
     assert_eq!(code, 0, "{stderr}");
     assert!(!stderr.contains("warning"), "{stderr}");
     assert!(stderr.contains("pilot: 3 strategies"), "{stderr}");
@@ -166,4 +164,8 @@ fn the_default_compare_sizes_its_reference_and_ends_without_warning() {
     // The table comes last, ranked: the best first, the last row a verdict against it.
     let last = stdout.lines().last().unwrap();
     assert!(last.ends_with("worse") || last.ends_with("tie"), "{stdout}");
+    // A second run's pilot differs by its noise, and still reuses the stored reference.
+    let (code, _, stderr) = dibench(&args, dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stderr.contains("reusing"), "{stderr}");
 }

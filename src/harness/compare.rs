@@ -336,7 +336,7 @@ impl Reference {
                 Need::Spp(_) => true,
                 Need::Floor { plan, .. } => meta
                     .noise_floor_rmse
-                    .is_some_and(|f| f <= plan.target_floor),
+                    .is_some_and(|f| f <= plan.accept_floor),
             });
         let (image, meta, variance) = match stored {
             Some(r) => {

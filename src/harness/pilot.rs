@@ -88,6 +88,9 @@ pub struct Plan {
     pub smallest_by: String,
     /// The floor to reach: `fraction · MARGIN · smallest_rmse`.
     pub target_floor: f64,
+    /// The floor a stored reference may have to be reused: `fraction · smallest_rmse` (the
+    /// margin is for rendering; without this slack every pilot's noise would re-render it).
+    pub accept_floor: f64,
     /// Passes the target needs by the pilot's σ², and their predicted time.
     pub predicted_spp: u64,
     pub predicted_s: f64,
@@ -129,6 +132,7 @@ pub fn plan(pilots: &[Pilot], budget_s: f64, fraction: f64) -> Vec<Plan> {
                 smallest_rmse,
                 smallest_by: smallest.strategy.clone(),
                 target_floor,
+                accept_floor: fraction * smallest_rmse,
                 predicted_spp,
                 predicted_s: predicted_spp as f64 * best.seconds_per_pass,
             })
@@ -163,6 +167,7 @@ mod tests {
         let smallest = (4.0f64 * 0.001 / 2.0).sqrt();
         assert!((pl.smallest_rmse - smallest).abs() < 1e-15);
         assert!((pl.target_floor - 0.1 * MARGIN * smallest).abs() < 1e-15);
+        assert!((pl.accept_floor - 0.1 * smallest).abs() < 1e-15);
         let floor = (4.0 / pl.predicted_spp as f64).sqrt();
         assert!(floor <= pl.target_floor, "{floor} > {}", pl.target_floor);
         // One pass fewer would miss it: the plan is not wasteful.
