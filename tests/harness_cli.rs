@@ -110,7 +110,10 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
         // Debiased MSE + floor² is the mean of the runs' MSE, at least the squared mean RMSE
         // (Jensen); debiased relMSE is relMSE less the reference's positive relMSE floor.
         let (rmse, mse_d): (f64, f64) = (r[8].parse().unwrap(), r[11].parse().unwrap());
-        assert!(mse_d + floor * floor >= rmse * rmse * (1.0 - 1e-12), "{summary}");
+        assert!(
+            mse_d + floor * floor >= rmse * rmse * (1.0 - 1e-12),
+            "{summary}"
+        );
         let (rel, rel_d): (f64, f64) = (r[13].parse().unwrap(), r[15].parse().unwrap());
         assert!(rel_d < rel, "{summary}");
         let slope: f64 = r[20].parse().expect("a convergence slope");
