@@ -65,9 +65,11 @@ pub fn accumulate(sum: &mut [f64; 3], m2: &mut [f64; 3], n: u64, x: [f64; 3]) {
         *sum = x;
         return;
     }
-    let (nf, w) = (n as f64, n as f64 / (n + 1) as f64);
+    // Per sample and pixel: two divisions, shared by the channels (d² ≥ 0 whatever the
+    // rounding of the mean, so the reciprocal is safe here; `mean` divides exactly).
+    let (inv, w) = (1.0 / n as f64, n as f64 / (n + 1) as f64);
     for c in 0..3 {
-        let d = x[c] - sum[c] / nf;
+        let d = x[c] - sum[c] * inv;
         m2[c] += d * d * w;
         sum[c] += x[c];
     }

@@ -2,7 +2,7 @@
 //! convergence slopes (`harness::pilot`, `harness::summary`).
 
 mod common;
-use common::dibench;
+use common::{TINY as SCENE, dibench, run_dirs};
 
 use dibench::film::{Film, Image};
 use dibench::harness::reference;
@@ -11,35 +11,6 @@ use dibench::prepare::PreparedScene;
 use dibench::render::Renderer;
 use dibench::scene::Scene;
 use dibench::strategy::Integrand;
-
-/// A quad light over a floor with a sphere (16×12 pixels).
-const SCENE: &str = r#"
-[camera]
-eye = [0.0, 1.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-[image]
-width = 16
-height = 12
-[[material]]
-name = "m"
-albedo = [0.5, 0.5, 0.5]
-[[quad]]
-corner = [-3.0, 0.0, -3.0]
-edge_u = [0.0, 0.0, 6.0]
-edge_v = [6.0, 0.0, 0.0]
-material = "m"
-[[quad]]
-corner = [-0.5, 1.5, -0.5]
-edge_u = [1.0, 0.0, 0.0]
-edge_v = [0.0, 0.0, 1.0]
-material = "m"
-emission = [4.0, 4.0, 4.0]
-[[sphere]]
-center = [0.3, 0.3, 0.0]
-radius = 0.3
-material = "m"
-"#;
 
 fn scene() -> PreparedScene {
     let dir = tempfile::tempdir().unwrap();
@@ -135,12 +106,9 @@ fn the_default_compare_sizes_its_reference_and_ends_without_warning() {
     assert!(!stderr.contains("warning"), "{stderr}");
     assert!(stderr.contains("pilot: 3 strategies"), "{stderr}");
     let scene_dir = dir.path().join("out/tiny");
-    let run = std::fs::read_dir(&scene_dir)
-        .unwrap()
-        .flatten()
-        .map(|e| e.path())
-        .find(|p| !p.ends_with("reference"))
-        .unwrap();
+    let runs = run_dirs(&scene_dir);
+    assert_eq!(runs.len(), 1, "{runs:?}");
+    let run = &runs[0];
     let summary = std::fs::read_to_string(run.join("summary.csv")).unwrap();
     let mut lines = summary.lines();
     let header = lines.next().unwrap();

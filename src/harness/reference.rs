@@ -15,7 +15,7 @@ use crate::render::Renderer;
 use crate::strategy::{Integrand, reference_strategy};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ReferenceMeta {
@@ -130,15 +130,6 @@ pub fn render_progressive(
     threads: usize,
     checkpoints: Option<&Locked>,
 ) -> Result<Rendered> {
-    match budget {
-        Budget::Spp(n) => super::options::check_at_least_one("--spp", n)?,
-        Budget::Time(t) => {
-            super::options::check_seconds("--time", t)?;
-        }
-        Budget::Floor { cap, .. } => {
-            super::options::check_seconds("--reference-cap", cap)?;
-        }
-    }
     let strategy = strategy_for(scene, integrand)?;
     render_with(scene, strategy.as_ref(), budget, seed, threads, checkpoints)
 }
@@ -153,6 +144,7 @@ pub fn render_with(
     checkpoints: Option<&Locked>,
 ) -> Result<Rendered> {
     let integrand = strategy.integrand();
+    // Validated here, where the budget is used, for every entry point.
     let (spp, time, floor) = match budget {
         Budget::Floor {
             target,
@@ -160,11 +152,18 @@ pub fn render_with(
             expected_spp,
         } => (
             expected_spp,
-            Some(Duration::try_from_secs_f64(cap).unwrap_or(Duration::MAX)),
+            Some(super::options::check_seconds("--reference-cap", cap)?),
             Some(target),
         ),
-        Budget::Spp(n) => (n, None, None),
-        Budget::Time(t) => (u64::MAX, Some(Duration::from_secs_f64(t)), None),
+        Budget::Spp(n) => {
+            super::options::check_at_least_one("--spp", n)?;
+            (n, None, None)
+        }
+        Budget::Time(t) => (
+            u64::MAX,
+            Some(super::options::check_seconds("--time", t)?),
+            None,
+        ),
     };
     let mut renderer = Renderer::new(scene, strategy, reference_stream_seed(seed))?;
     let bar = progress_bar(
