@@ -8,13 +8,10 @@ use crate::env::{Environment, Repr};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
-use crate::lights::directional::DirectionalLight;
 use crate::lights::environment::EnvironmentLight;
 use crate::lights::mesh::TriangleLight;
-use crate::lights::point::PointLight;
 use crate::lights::quad::QuadLight;
 use crate::lights::sphere::SphereLight;
-use crate::lights::spot::SpotLight;
 use crate::lights::{EmitterRef, Light, LightSet};
 use crate::scene::Scene;
 use crate::strategy::Integrand;
@@ -189,28 +186,9 @@ impl PreparedScene {
             prim_material.push(s.material);
             prim_emitter.push(light.map(|light| EmitterRef { light, local: 0 }));
         }
-        for p in &scene.point_lights {
-            lights.push(Box::new(PointLight {
-                position: p.position,
-                intensity: p.intensity,
-            }));
-        }
-        for s in &scene.spot_lights {
-            lights.push(Box::new(SpotLight {
-                position: s.position,
-                axis: s.direction,
-                intensity: s.intensity,
-                cos_cone: s.cos_cone,
-                cos_falloff_start: s.cos_falloff_start,
-            }));
-        }
         let radius = bounding_radius(&g, &scene.camera);
-        for d in &scene.directional_lights {
-            lights.push(Box::new(DirectionalLight {
-                to_light: -d.direction,
-                irradiance: d.irradiance,
-                scene_radius: radius,
-            }));
+        for l in &scene.lights {
+            lights.push(l.spec.place(radius));
         }
         let environment = scene.environment.as_ref().map(|spec| {
             let env = Arc::new(Environment::build(&|w| spec.radiance(w)));

@@ -298,6 +298,35 @@ fn every_bad_input_class_exits_nonzero_naming_file_and_field() {
         ),
         ("unreadable file", mesh("folder.obj"), &["folder.obj"]),
         (
+            "unknown top-level key",
+            format!("{GOOD}[[pointlight]]\nposition = [0.0, 2.0, 0.0]\n"),
+            &["pointlight", "point_light", "linear_spot_light"],
+        ),
+        (
+            "light type given as a value",
+            format!("point_light = 3\n{GOOD}"),
+            &["point_light", "array of tables"],
+        ),
+        (
+            "unknown light field",
+            format!(
+                "{GOOD}[[spot_light]]\nposition = [0.0, 2.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ncone_angle_deg = 30.0\nintensity = [1.0, 1.0, 1.0]\ncolour = 1\n"
+            ),
+            &["spot_light[0].colour", "falloff_start_deg"],
+        ),
+        (
+            "light field out of range",
+            format!(
+                "{GOOD}[[linear_spot_light]]\nposition = [0.0, 2.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\ncone_angle_deg = 200.0\nintensity = [1.0, 1.0, 1.0]\n"
+            ),
+            &["linear_spot_light[0].cone_angle_deg", "[0, 180]"],
+        ),
+        (
+            "light field missing",
+            format!("{GOOD}[[directional_light]]\nirradiance = [1.0, 1.0, 1.0]\n"),
+            &["directional_light[0].direction", "missing"],
+        ),
+        (
             "NaN vertex",
             mesh("nan.obj"),
             &["mesh[0].file", "nan.obj", "vertex 2"],

@@ -53,11 +53,13 @@ fn prepare_builds_only_what_the_scene_declares() {
                     .count()
             })
             .sum();
-        let (points, spots, dirs) = (
-            s.point_lights.len(),
-            s.spot_lights.len(),
-            s.directional_lights.len(),
-        );
+        // Every registered light type is point-shaped but the directional one.
+        let dirs = s
+            .lights
+            .iter()
+            .filter(|l| std::ptr::eq(l.kind, &dibench::lights::directional::DIRECTIONAL))
+            .count();
+        let points = s.lights.len() - dirs;
         let has_env = s.environment.is_some();
         let has_ao = s.ao_distance.is_some();
         let n_spheres = s.spheres.len();
@@ -67,7 +69,7 @@ fn prepare_builds_only_what_the_scene_declares() {
             (LightShape::Quad, quads),
             (LightShape::Sphere, spheres),
             (LightShape::Mesh, meshes),
-            (LightShape::Point, points + spots),
+            (LightShape::Point, points),
             (LightShape::Direction, dirs),
             (LightShape::Environment, has_env as usize),
         ] {

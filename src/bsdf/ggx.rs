@@ -184,6 +184,7 @@ pub static GGX: MaterialType = MaterialType {
         "k",
     ],
     parse: parse_ggx,
+    chi2_cases,
 };
 
 fn parse_ggx(p: &mut Params) -> Result<Bsdf> {

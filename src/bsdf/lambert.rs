@@ -44,6 +44,8 @@ pub static DIFFUSE: MaterialType = MaterialType {
     describe: "Lambertian reflection of albedo kd",
     fields: &["albedo"],
     parse: parse_diffuse,
+    // Its sampler is the cosine warp, tested with the warps (`sampling::warp`).
+    chi2_cases: crate::chi2::no_cases,
 };
 
 fn parse_diffuse(p: &mut Params) -> Result<Bsdf> {

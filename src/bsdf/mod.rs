@@ -383,49 +383,10 @@ impl LocalBsdf<'_> {
     }
 }
 
-/// The χ² cases of BSDF sampling: the diffuse + Phong blend, lobe chosen by coefficient, with
-/// the mixture pdf, seen from `theta_o` off the normal; then the GGX samplers' and the
-/// principled material's, from their files.
+/// The χ² cases of BSDF sampling: each material type's, in [`MATERIALS`] order (from the
+/// file beside its lobe).
 pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
-    use crate::chi2::{Chart, DEFAULT_SLACK, WarpCase, WarpEntry, label, param};
-    let mut v = vec![WarpEntry::new(
-        "bsdf-blend",
-        "diffuse + normalized Phong blend, lobe chosen by coefficient; wo at theta_o from the normal",
-        &[("kd", 0.5), ("ks", 0.4), ("n", 10.0), ("theta_o", 30.0)],
-        &[
-            &[],
-            &[("kd", 0.0), ("ks", 1.0), ("n", 5.0), ("theta_o", 70.0)],
-            &[("kd", 0.9), ("ks", 0.1), ("n", 50.0), ("theta_o", 0.0)],
-        ],
-        |p| {
-            let (kd, ks, n, theta) = (
-                param(p, "kd"),
-                param(p, "ks"),
-                param(p, "n"),
-                param(p, "theta_o").to_radians(),
-            );
-            if kd < 0.0 || ks < 0.0 || kd + ks > 1.0 || kd + ks == 0.0 || n < 0.0 {
-                return Err("need kd, ks ≥ 0 with 0 < kd + ks ≤ 1, and n ≥ 0".into());
-            }
-            let bsdf = Bsdf::blend(Vec3::splat(kd), Vec3::splat(ks), n);
-            let b2 = bsdf.clone();
-            let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
-            let policy = BsdfSampling::default();
-            Ok(WarpCase {
-                label: label("bsdf-blend", p),
-                sample: Box::new(move |u| {
-                    let wi = bsdf.sample_local(wo, u, policy);
-                    Some((wi, bsdf.pdf(wo, wi, policy)))
-                }),
-                pdf: Box::new(move |w| b2.pdf(wo, w, policy) as f64),
-                mismatch_slack: DEFAULT_SLACK,
-                chart: Chart::sphere(),
-            })
-        },
-    )];
-    v.extend(ggx::chi2_cases());
-    v.extend(principled::chi2_cases());
-    v
+    MATERIALS.iter().flat_map(|t| (t.chi2_cases)()).collect()
 }
 
 #[cfg(test)]

@@ -113,6 +113,7 @@ pub static PRINCIPLED: MaterialType = MaterialType {
         "alpha",
     ],
     parse: parse_principled,
+    chi2_cases,
 };
 
 fn parse_principled(p: &mut Params) -> Result<Bsdf> {

@@ -221,6 +221,12 @@ impl WarpEntry {
 }
 
 /// `name(k=v, ...)`: a case's label.
+/// No χ² cases: for a registry entry with no density of its own to test (a delta light, or a
+/// sampler tested elsewhere).
+pub fn no_cases() -> Vec<WarpEntry> {
+    Vec::new()
+}
+
 pub fn label(name: &str, p: &Params) -> String {
     let args: Vec<String> = p.iter().map(|(k, v)| format!("{k}={v}")).collect();
     format!("{name}({})", args.join(", "))

@@ -1,5 +1,6 @@
 //! Every sampler dibench has, for the χ² suite and `dibench warp`: the concatenation of the
-//! cases each module exports beside its samplers.
+//! cases each module exports beside its samplers (material and light types through their
+//! registries, so a new type's cases need no line here).
 
 use super::WarpEntry;
 
@@ -9,6 +10,11 @@ pub fn registry() -> Vec<WarpEntry> {
     v.extend(crate::lights::quad::chi2_cases());
     v.extend(crate::lights::sphere::chi2_cases());
     v.extend(crate::lights::mesh::chi2_cases());
+    v.extend(
+        crate::lights::LIGHT_TYPES
+            .iter()
+            .flat_map(|t| (t.chi2_cases)()),
+    );
     v.extend(crate::env::chi2_cases());
     v
 }

@@ -2,9 +2,48 @@
 //! Its shadow ray is unbounded.
 
 use super::bounds::{Bounds, DistantBounds};
-use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape};
+use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, LightSpec, LightType};
 use crate::math::luminance;
 use glam::Vec3;
+use std::sync::Arc;
+
+/// `[[directional_light]]`: `direction` (the way the light travels, towards the scene) and
+/// `irradiance` E⊥ [W/m²] on a surface facing it.
+pub static DIRECTIONAL: LightType = LightType {
+    name: "directional_light",
+    describe: "distant light from one direction",
+    fields: &["direction", "irradiance"],
+    parse: |p| {
+        let direction = p.direction("direction")?;
+        let irradiance = p.required_rgb("irradiance")?;
+        if irradiance.min_element() < 0.0 {
+            return Err(p.error("irradiance", "must be non-negative"));
+        }
+        Ok(Arc::new(Placed {
+            to_light: -direction,
+            irradiance,
+        }))
+    },
+    chi2_cases: crate::chi2::no_cases,
+};
+
+/// A directional light before the scene is known: its power is π r² E⊥ for a scene of
+/// radius r.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    to_light: Vec3,
+    irradiance: Vec3,
+}
+
+impl LightSpec for Placed {
+    fn place(&self, scene_radius: f32) -> Box<dyn Light> {
+        Box::new(DirectionalLight {
+            to_light: self.to_light,
+            irradiance: self.irradiance,
+            scene_radius,
+        })
+    }
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct DirectionalLight {

@@ -5,14 +5,24 @@
 //! direct-illumination integral, or reports a delta light.
 
 pub mod bounds;
-pub mod directional;
 pub mod environment;
 pub mod mesh;
-pub mod point;
 pub mod quad;
 pub mod selector;
 pub mod sphere;
-pub mod spot;
+
+crate::plugin::registry! {
+    /// Every light type a scene file names by a table array of its own (`[[spot_light]]`), in
+    /// listing order (the order their lights take in a scene's light list). Lights that are the
+    /// surface of a shape (`emission` on a quad, sphere or mesh) and the environment are part
+    /// of their shape's or the environment's description instead.
+    pub static LIGHT_TYPES: LightType = [
+        point::POINT,
+        spot::SPOT,
+        directional::DIRECTIONAL,
+        linear_spot::LINEAR_SPOT,
+    ];
+}
 
 use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
@@ -21,6 +31,40 @@ use bounds::Bounds;
 use glam::Vec3;
 use selector::{LightSelector, SELECTORS, SelectorType};
 use std::sync::{Arc, OnceLock};
+
+/// A kind of light as the scene format names it: the table array `[[name]]` and how one of
+/// its tables becomes a light. One file declares it beside its `impl Light`, and one line in
+/// [`LIGHT_TYPES`] registers it; nothing else in the crate names it.
+pub struct LightType {
+    /// The scene file's table array (`spot_light` for `[[spot_light]]`).
+    pub name: &'static str,
+    pub describe: &'static str,
+    /// The fields it reads, for error messages.
+    pub fields: &'static [&'static str],
+    /// Builds the light from its table; fields it does not read are reported by the caller.
+    pub parse: fn(&mut crate::scene::params::Params) -> crate::error::Result<Arc<dyn LightSpec>>,
+    /// Its χ² cases (sample/pdf pairs), for the χ² suite and `dibench warp`; none for a delta
+    /// light.
+    pub chi2_cases: fn() -> Vec<crate::chi2::WarpEntry>,
+}
+
+impl std::fmt::Debug for LightType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+/// A light as parsed, before the scene is known: a distant light's power depends on the size
+/// of the scene it falls on, so the light is placed once the scene is bounded.
+pub trait LightSpec: Send + Sync + std::fmt::Debug {
+    /// The light for a scene whose bounding sphere has radius `scene_radius` (> 0).
+    fn place(&self, scene_radius: f32) -> Box<dyn Light>;
+}
+
+/// The type named `name`.
+pub fn light_type(name: &str) -> Option<&'static LightType> {
+    LIGHT_TYPES.iter().copied().find(|t| t.name == name)
+}
 
 /// One sample of incident light at a shading point.
 #[derive(Clone, Copy, Debug)]
@@ -437,12 +481,16 @@ impl LightSet {
 
     /// The selector of type `kind` over these lights, built on first use; Err says why it
     /// cannot select among them (no light with positive power, too many lights for an O(n)
-    /// selector).
+    /// selector, a type not in `SELECTORS`).
     pub fn selector(&self, kind: &'static SelectorType) -> Result<&dyn LightSelector, String> {
-        let k = SELECTORS
-            .iter()
-            .position(|s| std::ptr::eq(*s, kind))
-            .expect("selector types come from SELECTORS");
+        // Built selectors are kept one per registered type; a type from outside the registry
+        // has no slot (and is refused, not a panic).
+        let Some(k) = SELECTORS.iter().position(|s| std::ptr::eq(*s, kind)) else {
+            return Err(format!(
+                "light selector `{}` is not registered in lights::selector::SELECTORS",
+                kind.name
+            ));
+        };
         match self.selectors[k].get_or_init(|| (kind.build)(&self.lights)) {
             Ok(s) => Ok(s.as_ref()),
             Err(why) => Err(why.clone()),

@@ -4,9 +4,71 @@
 //! θs = θe the edge is hard.
 
 use super::bounds::{Bounds, LightBounds};
-use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, direction_to};
+use super::{
+    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, LightSpec, LightType,
+    direction_to,
+};
+use crate::error::Result;
 use crate::math::luminance;
+use crate::scene::params::Params;
 use glam::Vec3;
+use std::sync::Arc;
+
+/// `[[spot_light]]`: `position`, `direction` (the axis), `cone_angle_deg` θe in [0, 180],
+/// `falloff_start_deg` θs in [0, θe] (default θe: a hard edge), and `power` or on-axis
+/// `intensity`.
+pub static SPOT: LightType = LightType {
+    name: "spot_light",
+    describe: "point light in a cone, smoothstep falloff in cos θ (pbrt-v4)",
+    fields: &[
+        "position",
+        "direction",
+        "cone_angle_deg",
+        "falloff_start_deg",
+        "power",
+        "intensity",
+    ],
+    parse: |p| {
+        let (cone, start) = parse_cone(p)?;
+        let (cos_cone, cos_falloff_start) = (cone.to_radians().cos(), start.to_radians().cos());
+        let intensity =
+            super::point::power_or_intensity(p, solid_angle(cos_cone, cos_falloff_start))?;
+        Ok(Arc::new(SpotLight {
+            position: p.required_rgb("position")?,
+            axis: p.direction("direction")?,
+            intensity,
+            cos_cone,
+            cos_falloff_start,
+        }))
+    },
+    chi2_cases: crate::chi2::no_cases,
+};
+
+/// `cone_angle_deg` in [0, 180] and `falloff_start_deg` in [0, cone] (default: the cone), in
+/// degrees; shared by the spot types.
+pub fn parse_cone(p: &mut Params) -> Result<(f32, f32)> {
+    let cone = p.required_number("cone_angle_deg")?;
+    if !(0.0..=180.0).contains(&cone) {
+        return Err(p.error(
+            "cone_angle_deg",
+            format!("must be in [0, 180], got {cone}"),
+        ));
+    }
+    let start = p.number("falloff_start_deg")?.unwrap_or(cone);
+    if !(0.0..=cone).contains(&start) {
+        return Err(p.error(
+            "falloff_start_deg",
+            format!("must be in [0, cone_angle_deg = {cone}], got {start}"),
+        ));
+    }
+    Ok((cone, start))
+}
+
+/// Φ/I₀ of a smoothstep spot (pbrt-v4 `SpotLight::Phi`): 2π [(1 − cos θs) + (cos θs − cos θe)/2],
+/// the smoothstep integrating to half its interval.
+fn solid_angle(cos_cone: f32, cos_falloff_start: f32) -> f32 {
+    2.0 * std::f32::consts::PI * ((1.0 - cos_falloff_start) + 0.5 * (cos_falloff_start - cos_cone))
+}
 
 #[derive(Clone, Copy, Debug)]
 pub struct SpotLight {
@@ -47,6 +109,12 @@ impl SpotLight {
     }
 }
 
+impl LightSpec for SpotLight {
+    fn place(&self, _scene_radius: f32) -> Box<dyn Light> {
+        Box::new(*self)
+    }
+}
+
 impl Light for SpotLight {
     fn shape(&self) -> LightShape {
         LightShape::Point
@@ -55,9 +123,7 @@ impl Light for SpotLight {
     /// Φ = 2π I₀ [(1 - cos θs) + (cos θs - cos θe)/2]: the smoothstep integrates to half its
     /// interval.
     fn power(&self) -> f32 {
-        2.0 * std::f32::consts::PI
-            * ((1.0 - self.cos_falloff_start) + 0.5 * (self.cos_falloff_start - self.cos_cone))
-            * luminance(self.intensity)
+        solid_angle(self.cos_cone, self.cos_falloff_start) * luminance(self.intensity)
     }
 
     /// Full intensity within θs of the axis (the normal cone), falling off over θc − θs

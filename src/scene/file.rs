@@ -20,8 +20,11 @@ impl TryFrom<Vec<f32>> for Triple {
     }
 }
 
+/// The whole file. Every top-level key is either one of these fields or a light type's table
+/// array (`[[point_light]]`, …: `lights::LIGHT_TYPES`), which lands in `lights` for its type
+/// to parse; `Scene::parse` refuses any other key (serde's `deny_unknown_fields` cannot be
+/// combined with the catch-all).
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct SceneFile {
     pub camera: CameraDesc,
     pub image: ImageDesc,
@@ -33,16 +36,13 @@ pub struct SceneFile {
     pub quads: Vec<QuadDesc>,
     #[serde(default, rename = "sphere")]
     pub spheres: Vec<SphereDesc>,
-    #[serde(default, rename = "point_light")]
-    pub point_lights: Vec<PointLightDesc>,
-    #[serde(default, rename = "spot_light")]
-    pub spot_lights: Vec<SpotLightDesc>,
-    #[serde(default, rename = "directional_light")]
-    pub directional_lights: Vec<DirectionalLightDesc>,
     /// Present: the scene also has the ambient-occlusion integrand (`ao-*` strategies).
     pub ambient_occlusion: Option<AmbientOcclusionDesc>,
     /// Radiance arriving from infinitely far away (a lat/long EXR or a constant).
     pub environment: Option<EnvironmentDesc>,
+    /// Every other top-level key: the light types' table arrays.
+    #[serde(flatten)]
+    pub lights: toml::Table,
 }
 
 #[derive(Debug, Deserialize)]
@@ -139,42 +139,6 @@ pub struct SphereDesc {
     pub material: String,
     /// Emitted radiance, on both faces: outward, and inward for points inside the sphere.
     pub emission: Option<Triple>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PointLightDesc {
-    pub position: Triple,
-    /// Radiant power Φ [W] per channel; the intensity is Φ/(4π) [W/sr]. Give this or
-    /// `intensity`, not both.
-    pub power: Option<Triple>,
-    /// Radiant intensity I [W/sr] per channel.
-    pub intensity: Option<Triple>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SpotLightDesc {
-    pub position: Triple,
-    /// The direction the spot points in (its axis).
-    pub direction: Triple,
-    /// Half-angle of the lit cone, degrees in [0, 180].
-    pub cone_angle_deg: f32,
-    /// Half-angle where the smoothstep falloff starts, degrees in [0, cone_angle_deg]
-    /// (default: cone_angle_deg, a hard edge).
-    pub falloff_start_deg: Option<f32>,
-    /// Power Φ [W] or on-axis intensity I [W/sr]; one of the two.
-    pub power: Option<Triple>,
-    pub intensity: Option<Triple>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DirectionalLightDesc {
-    /// The direction the light travels in (from the light towards the scene).
-    pub direction: Triple,
-    /// Irradiance E⊥ [W/m²] on a surface facing the light.
-    pub irradiance: Triple,
 }
 
 #[derive(Debug, Deserialize)]

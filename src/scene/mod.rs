@@ -3,12 +3,15 @@
 
 pub mod file;
 mod obj;
+pub mod params;
 
 use crate::bounded;
 use crate::env::map::LatLongImage;
 use crate::error::{Error, Result};
+use crate::lights::{LIGHT_TYPES, LightSpec, LightType, light_type};
 use file::SceneFile;
 use glam::{Quat, Vec3};
+use params::Params;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -30,9 +33,9 @@ pub struct Scene {
     pub meshes: Vec<Mesh>,
     pub quads: Vec<Quad>,
     pub spheres: Vec<SphereShape>,
-    pub point_lights: Vec<PointLight>,
-    pub spot_lights: Vec<SpotLight>,
-    pub directional_lights: Vec<DirectionalLight>,
+    /// The lights that are not a shape's surface or the environment, in the order of
+    /// `lights::LIGHT_TYPES`, each type's in file order.
+    pub lights: Vec<SceneLight>,
     /// Occlusion distance of the ambient-occlusion integrand, when the scene asks for it.
     pub ao_distance: Option<f32>,
     pub environment: Option<EnvironmentSpec>,
@@ -113,29 +116,88 @@ pub struct SphereShape {
     pub emission: Option<Vec3>,
 }
 
-#[derive(Clone, Copy, Debug)]
-pub struct PointLight {
-    pub position: Vec3,
-    /// Radiant intensity I = Φ/(4π) [W/sr].
-    pub intensity: Vec3,
+/// One light of a type in `lights::LIGHT_TYPES`, as parsed (placed in the scene by
+/// `prepare`).
+#[derive(Clone, Debug)]
+pub struct SceneLight {
+    pub kind: &'static LightType,
+    /// `spot_light[0]`: the table it came from, for messages.
+    pub field: String,
+    pub spec: Arc<dyn LightSpec>,
 }
 
-#[derive(Clone, Copy, Debug)]
-pub struct SpotLight {
-    pub position: Vec3,
-    /// Unit axis.
-    pub direction: Vec3,
-    /// On-axis intensity [W/sr].
-    pub intensity: Vec3,
-    pub cos_cone: f32,
-    pub cos_falloff_start: f32,
-}
+/// The top-level keys `SceneFile` reads itself (the rest must be light types).
+const SCENE_KEYS: &[&str] = &[
+    "camera",
+    "image",
+    "material",
+    "mesh",
+    "quad",
+    "sphere",
+    "ambient_occlusion",
+    "environment",
+];
 
-#[derive(Clone, Copy, Debug)]
-pub struct DirectionalLight {
-    /// Unit direction the light travels in.
-    pub direction: Vec3,
-    pub irradiance: Vec3,
+/// Each remaining top-level key as a light type's table array, parsed by its type in
+/// `LIGHT_TYPES` order; any other key is an error naming it.
+fn parse_lights(path: &Path, mut tables: toml::Table) -> Result<Vec<SceneLight>> {
+    if let Some(key) = tables.keys().find(|k| light_type(k).is_none()) {
+        let types: Vec<_> = LIGHT_TYPES.iter().map(|t| t.name).collect();
+        return Err(Error::field(
+            path,
+            key.as_str(),
+            format!(
+                "unknown key `{key}` (the scene's keys: {}; light types: {})",
+                SCENE_KEYS.join(", "),
+                types.join(", ")
+            ),
+        ));
+    }
+    let mut lights = Vec::new();
+    for kind in LIGHT_TYPES.iter().copied() {
+        let Some(value) = tables.remove(kind.name) else {
+            continue;
+        };
+        let toml::Value::Array(entries) = value else {
+            return Err(Error::field(
+                path,
+                kind.name,
+                format!(
+                    "expected an array of tables `[[{}]]`, got {}",
+                    kind.name,
+                    value.type_str()
+                ),
+            ));
+        };
+        for (i, entry) in entries.into_iter().enumerate() {
+            let toml::Value::Table(table) = entry else {
+                return Err(Error::field(
+                    path,
+                    format!("{}[{i}]", kind.name),
+                    format!("expected a table, got {}", entry.type_str()),
+                ));
+            };
+            let mut params = Params::new(path, kind.name, i, table);
+            let spec = (kind.parse)(&mut params)?;
+            if let Some(key) = params.leftover() {
+                let key = key.to_string();
+                return Err(params.error(
+                    &key,
+                    format!(
+                        "unknown field for a `{}` (its fields: {})",
+                        kind.name,
+                        kind.fields.join(", ")
+                    ),
+                ));
+            }
+            lights.push(SceneLight {
+                kind,
+                field: params.field(""),
+                spec,
+            });
+        }
+    }
+    Ok(lights)
 }
 
 impl Scene {
@@ -150,9 +212,8 @@ impl Scene {
     }
 
     pub fn has_delta_lights(&self) -> bool {
-        !self.point_lights.is_empty()
-            || !self.spot_lights.is_empty()
-            || !self.directional_lights.is_empty()
+        // The radius does not change whether a light is a delta light.
+        self.lights.iter().any(|l| l.spec.place(1.0).is_delta())
     }
 
     pub fn pixel_count(&self) -> usize {
@@ -347,71 +408,7 @@ impl Scene {
             });
         }
 
-        let mut point_lights = Vec::new();
-        for (i, l) in desc.point_lights.iter().enumerate() {
-            let f = format!("point_light[{i}]");
-            // Isotropic: Φ = 4π I.
-            let intensity =
-                v.power_or_intensity(&f, l.power, l.intensity, 4.0 * std::f32::consts::PI)?;
-            point_lights.push(PointLight {
-                position: v.vec3(&format!("{f}.position"), l.position)?,
-                intensity,
-            });
-        }
-        let mut spot_lights = Vec::new();
-        for (i, l) in desc.spot_lights.iter().enumerate() {
-            let f = format!("spot_light[{i}]");
-            let cone = v.finite(&format!("{f}.cone_angle_deg"), l.cone_angle_deg)?;
-            if !(0.0..=180.0).contains(&cone) {
-                return Err(Error::field(
-                    path,
-                    format!("{f}.cone_angle_deg"),
-                    format!("must be in [0, 180], got {cone}"),
-                ));
-            }
-            let start = v.finite(
-                &format!("{f}.falloff_start_deg"),
-                l.falloff_start_deg.unwrap_or(cone),
-            )?;
-            if !(0.0..=cone).contains(&start) {
-                return Err(Error::field(
-                    path,
-                    format!("{f}.falloff_start_deg"),
-                    format!("must be in [0, cone_angle_deg = {cone}], got {start}"),
-                ));
-            }
-            let (cos_cone, cos_falloff_start) = (cone.to_radians().cos(), start.to_radians().cos());
-            // Φ/I of a smoothstep spot (pbrt-v4 SpotLight::Phi): 2π [(1 - cos θs) + (cos θs - cos θe)/2].
-            let solid = 2.0
-                * std::f32::consts::PI
-                * ((1.0 - cos_falloff_start) + 0.5 * (cos_falloff_start - cos_cone));
-            let intensity = v.power_or_intensity(&f, l.power, l.intensity, solid)?;
-            let direction = v.unit(&format!("{f}.direction"), l.direction)?;
-            let position = v.vec3(&format!("{f}.position"), l.position)?;
-            spot_lights.push(SpotLight {
-                position,
-                direction,
-                intensity,
-                cos_cone,
-                cos_falloff_start,
-            });
-        }
-        let mut directional_lights = Vec::new();
-        for (i, l) in desc.directional_lights.iter().enumerate() {
-            let f = format!("directional_light[{i}]");
-            let irradiance = v.vec3(&format!("{f}.irradiance"), l.irradiance)?;
-            if irradiance.min_element() < 0.0 {
-                return Err(Error::field(
-                    path,
-                    format!("{f}.irradiance"),
-                    "must be non-negative",
-                ));
-            }
-            directional_lights.push(DirectionalLight {
-                direction: v.unit(&format!("{f}.direction"), l.direction)?,
-                irradiance,
-            });
-        }
+        let lights = parse_lights(path, desc.lights)?;
         let ao_distance = match &desc.ambient_occlusion {
             None => None,
             Some(ao) => {
@@ -457,9 +454,7 @@ impl Scene {
             meshes,
             quads,
             spheres,
-            point_lights,
-            spot_lights,
-            directional_lights,
+            lights,
             ao_distance,
             environment,
             light_power: 0.0,
@@ -526,20 +521,9 @@ impl Scene {
                 ));
             }
         }
-        for (i, l) in self.point_lights.iter().enumerate() {
-            out.push((format!("point_light[{i}]"), 4.0 * PI * lum(l.intensity)));
-        }
-        for (i, l) in self.spot_lights.iter().enumerate() {
-            let (c, s) = (l.cos_cone as f64, l.cos_falloff_start as f64);
-            let solid = 2.0 * PI * ((1.0 - s) + 0.5 * (s - c));
-            out.push((format!("spot_light[{i}]"), solid * lum(l.intensity)));
-        }
         let r = self.bounding_radius();
-        for (i, l) in self.directional_lights.iter().enumerate() {
-            out.push((
-                format!("directional_light[{i}]"),
-                PI * r * r * lum(l.irradiance),
-            ));
+        for l in &self.lights {
+            out.push((l.field.clone(), l.spec.place(r as f32).power() as f64));
         }
         if let Some(e) = &self.environment {
             // ∫ L dω over the source: texel rows of the lat/long map span θ0..θ1 of 2π/W each.
@@ -752,60 +736,6 @@ impl Validator<'_> {
             scale,
             rotation: Quat::from_rotation_y(angle.to_radians()),
         })
-    }
-
-    fn unit(&self, field: &str, a: file::Triple) -> Result<Vec3> {
-        let d = self.vec3(field, a)?.normalize_or_zero();
-        if d == Vec3::ZERO {
-            return Err(Error::field(
-                self.path,
-                field,
-                "must be a non-zero direction",
-            ));
-        }
-        Ok(d)
-    }
-
-    /// Intensity from exactly one of `power` (divided by the light's solid-angle factor) or
-    /// `intensity`.
-    fn power_or_intensity(
-        &self,
-        light: &str,
-        power: Option<file::Triple>,
-        intensity: Option<file::Triple>,
-        solid_angle: f32,
-    ) -> Result<Vec3> {
-        let (field, value) = match (power, intensity) {
-            (Some(p), None) => (
-                format!("{light}.power"),
-                self.vec3(&format!("{light}.power"), p)?,
-            ),
-            (None, Some(i)) => (
-                format!("{light}.intensity"),
-                self.vec3(&format!("{light}.intensity"), i)?,
-            ),
-            _ => {
-                return Err(Error::field(
-                    self.path,
-                    light,
-                    "give exactly one of `power` and `intensity`",
-                ));
-            }
-        };
-        if value.min_element() < 0.0 {
-            return Err(Error::field(self.path, field, "must be non-negative"));
-        }
-        if power.is_some() {
-            if solid_angle <= 0.0 {
-                return Err(Error::field(
-                    self.path,
-                    field,
-                    "a light with an empty cone has no power to distribute: give `intensity`",
-                ));
-            }
-            return Ok(value / solid_angle);
-        }
-        Ok(value)
     }
 
     fn camera(&self, c: &file::CameraDesc) -> Result<Camera> {
