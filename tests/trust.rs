@@ -137,3 +137,57 @@ fn the_default_compare_sizes_its_reference_and_ends_without_warning() {
     assert_eq!(code, 0, "{stderr}");
     assert!(stderr.contains("reusing"), "{stderr}");
 }
+
+/// `compare --plan` prints one plan per integrand and renders and writes nothing. The plan's
+/// time is the model's T/(f·MARGIN)² (the reference strategy is the one of smallest predicted
+/// RMSE); a cap shorter than it is named with the floor it would leave.
+#[test]
+fn compare_plan_prints_the_reference_plan_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let plan = |cap: &str| {
+        let args = [
+            "compare",
+            "tiny.toml",
+            "--plan",
+            "--time",
+            "0.1",
+            "--strategies",
+            "light,cosine",
+            "--threads",
+            "1",
+            "--reference-cap",
+            cap,
+            "--out",
+            "out",
+        ];
+        let (code, stdout, stderr) = dibench(&args, dir.path());
+        assert_eq!(code, 0, "{stderr}");
+        stdout
+    };
+    let stdout = plan("1800");
+    let lines: Vec<&str> = stdout.lines().collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    let (header, row) = (lines[0], lines[1]);
+    assert_eq!(field(header, row, "integrand"), "direct");
+    let strategy = field(header, row, "reference_strategy");
+    assert_eq!(strategy, field(header, row, "smallest_by"), "{row}");
+    let share: f64 = field(header, row, "target_share").parse().unwrap();
+    assert!(
+        (share - 0.1 * dibench::harness::pilot::MARGIN).abs() < 1e-3,
+        "{row}"
+    );
+    let secs: f64 = field(header, row, "predicted_s").parse().unwrap();
+    let model = 0.1 / (0.1f64 * dibench::harness::pilot::MARGIN).powi(2);
+    assert!(
+        (secs - model).abs() <= 0.01 * model,
+        "{secs} s vs the model's {model} s: {row}"
+    );
+    assert_eq!(field(header, row, "outcome"), "reaches the floor");
+    assert!(!dir.path().join("out").exists(), "--plan wrote output");
+    let capped = plan("1");
+    assert!(
+        capped.contains("the cap (1 s) ends it at a floor of about"),
+        "{capped}"
+    );
+}

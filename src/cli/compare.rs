@@ -33,6 +33,11 @@ pub struct CompareArgs {
     /// confidence intervals over them.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub runs: u32,
+    /// Run the pilots only and print each reference's plan (its strategy, target floor,
+    /// predicted samples and time, and whether `--reference-cap` would end it first); render
+    /// nothing and write nothing.
+    #[arg(long, conflicts_with = "reference_spp")]
+    pub plan: bool,
 }
 
 pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
@@ -73,6 +78,11 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
             3000,
         )),
     )?;
+    if a.plan {
+        let plans = pool.install(|| pilot_plans(&scene, &run, &a))?;
+        print_plans(&scene.scene.name, &plans, &a);
+        return Ok(());
+    }
     // The output location is checked, and the run's directory taken, before any rendering.
     crate::output::check_output_dir(&a.common.out, "--out")?;
     let run_dir = compare::create_run_dir(&a.common.out, &scene.scene.name, a.common.seed)?;
@@ -91,24 +101,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         // Without a fixed --reference-spp, pilots size each reference (`harness::pilot`).
         let plans = match a.reference_spp {
             Some(_) => Vec::new(),
-            None => {
-                let each = Duration::from_secs_f64((0.05 * a.time).clamp(0.25, 2.0));
-                eprintln!(
-                    "pilot: {} strategies, {:.2} s each, to size the reference",
-                    run.len(),
-                    each.as_secs_f64()
-                );
-                let pilots = run
-                    .iter()
-                    .map(|s| pilot::pilot(&scene, s.as_ref(), a.common.seed, each))
-                    .collect::<Result<Vec<_>>>()?;
-                if crate::interrupt::requested() {
-                    return Err(Error::Interrupted(
-                        "compare stopped during the pilot".into(),
-                    ));
-                }
-                pilot::plan(&pilots, a.time, a.reference_floor)
-            }
+            None => pilot_plans(&scene, &run, &a)?,
         };
         let mut images = Vec::new();
         for integrand in strategy::integrands(&scene) {
@@ -164,6 +157,64 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         run_dir.abandon(e);
     }
     result
+}
+
+/// A pilot of every strategy in `run`, 5 % of the budget each (0.25 s to 2 s), and the
+/// reference plan they give each integrand (`harness::pilot`).
+fn pilot_plans(
+    scene: &crate::prepare::PreparedScene,
+    run: &[Box<dyn Strategy>],
+    a: &CompareArgs,
+) -> Result<Vec<pilot::Plan>> {
+    let each = Duration::from_secs_f64((0.05 * a.time).clamp(0.25, 2.0));
+    eprintln!(
+        "pilot: {} strategies, {:.2} s each, to size the reference",
+        run.len(),
+        each.as_secs_f64()
+    );
+    let pilots = run
+        .iter()
+        .map(|s| pilot::pilot(scene, s.as_ref(), a.common.seed, each))
+        .collect::<Result<Vec<_>>>()?;
+    if crate::interrupt::requested() {
+        return Err(Error::Interrupted(
+            "compare stopped during the pilot".into(),
+        ));
+    }
+    Ok(pilot::plan(&pilots, a.time, a.reference_floor))
+}
+
+/// `compare --plan`: one line per integrand. The floor falls as 1/√N and N grows with time,
+/// so a reference the cap stops reaches the target floor × √(predicted time / cap).
+fn print_plans(scene: &str, plans: &[pilot::Plan], a: &CompareArgs) {
+    println!(
+        "scene,integrand,reference_strategy,smallest_predicted_rmse,smallest_by,target_floor,\
+         target_share,predicted_spp,predicted_s,outcome"
+    );
+    for p in plans {
+        let outcome = if p.predicted_s <= a.reference_cap {
+            "reaches the floor".to_string()
+        } else {
+            let floor = p.target_floor * (p.predicted_s / a.reference_cap).sqrt();
+            format!(
+                "the cap ({:.0} s) ends it at a floor of about {floor:.2e} ({:.0} % of the \
+                 smallest RMSE)",
+                a.reference_cap,
+                100.0 * floor / p.smallest_rmse
+            )
+        };
+        println!(
+            "{scene},{},{},{:.3e},{},{:.3e},{:.3},{},{:.1},{outcome}",
+            p.integrand.name(),
+            p.strategy,
+            p.smallest_rmse,
+            p.smallest_by,
+            p.target_floor,
+            p.target_floor / p.smallest_rmse,
+            p.predicted_spp,
+            p.predicted_s,
+        );
+    }
 }
 
 fn parse_fraction(s: &str) -> std::result::Result<f64, String> {
