@@ -33,12 +33,18 @@ pub struct CompareArgs {
     /// confidence intervals over them.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub runs: u32,
+    /// Comma-separated sample generators; every strategy runs with each
+    /// (independent, stratified, sobol, zsobol; stratified needs a fixed sample count, which
+    /// an equal-time run does not have, and is refused). References stay independent.
+    #[arg(long, value_delimiter = ',', default_value = "independent")]
+    pub sampler: Vec<String>,
 }
 
 pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
     // --time and --runs are bounded by their parsers; their seeds together, here, before
     // anything is loaded.
     options::check_seeds(a.common.seed, a.runs)?;
+    compare::resolve_samplers(&a.sampler)?;
     let (pool, threads) = pool(a.common.threads)?;
     let (scene, isa) = load_with(&a.common)?;
     scene.scene.require_light_power()?;
@@ -151,6 +157,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
             threads,
             runs: a.runs,
             isa: isa.to_string(),
+            samplers: a.sampler.clone(),
         };
         let report = compare::run(&scene, &run, skipped, &references, &run_dir, &opts)?;
         // The warnings, then the report, whose ranked table comes last.
