@@ -6,7 +6,7 @@
 
 use dibench::prepare::PreparedScene;
 use dibench::sampling::qmc::{is_02_net, owen, sobol_0, sobol_1};
-use dibench::sampling::sobol::{fill_groups, group_seed};
+use dibench::sampling::sobol::{fill_groups, group_seed, sequence_seed};
 use dibench::sampling::stratified::grid;
 use dibench::sampling::{
     Dims, GENERATORS, Layout, SampleGenerator, SampleKey, Setup, generator, stream::name_id,
@@ -388,7 +388,10 @@ fn no_dimension_is_reused_within_a_sample() {
             g.name()
         );
     }
-    let broken = collect(&|k, v| fill_groups(&setup, k.index as u32, |_| group_seed(&k, 0, 0), v));
+    let broken = collect(&|k, v| {
+        let seq = sequence_seed(&k, 0);
+        fill_groups(&setup, k.index as u32, |_| group_seed(seq, 0), v)
+    });
     assert!(worst(&broken) > 0.9, "a reused dimension is not seen");
 }
 
@@ -527,4 +530,27 @@ fn closed_form_check_with_replicates_rejects_a_biased_generator() {
         .check_with(&Squashed, light.as_ref(), 32 * 4096, 3, 1e-4, 0.03)
         .unwrap_err();
     assert!(err.contains("closed form"), "{err}");
+}
+
+/// The cost of one `fill` of the MIS layout per generator (ns), printed; not a check (run with
+/// `--ignored --nocapture`): what a sample generator adds to every sample at equal time.
+#[test]
+#[ignore]
+fn fill_cost() {
+    let mis = dibench::strategy::by_name("mis-power").unwrap();
+    let sc = scene("cornell");
+    let layout = Layout::camera().then(mis.bind(sc.view(mis.integrand())).unwrap().layout());
+    let setup = Setup::image(Layout::of(&layout.0[1..]), None, 128, 128);
+    for g in GENERATORS.iter().filter(|g| g.name() != "stratified") {
+        let mut v = vec![0.0f32; setup.layout.len()];
+        let mut acc = 0.0f32;
+        let t = std::time::Instant::now();
+        let n = 2_000_000u64;
+        for k in 0..n {
+            g.fill(&setup, key(1, k % 16384, k / 16384), &mut v);
+            acc += v[3];
+        }
+        let ns = t.elapsed().as_nanos() as f64 / n as f64;
+        println!("{:<12} {ns:6.1} ns per fill ({acc})", g.name());
+    }
 }

@@ -16,8 +16,57 @@ pub fn sobol_0(i: u32) -> u32 {
 }
 
 /// Sobol dimension 1 of point `i`, as a 32-bit binary fraction. Its generator matrix is the
-/// Pascal matrix mod 2: column k is v_k with v_0 = 1/2 and v_{k+1} = v_k ⊕ (v_k >> 1).
-pub fn sobol_1(mut i: u32) -> u32 {
+/// Pascal matrix mod 2: column k is v_k with v_0 = 1/2 and v_{k+1} = v_k ⊕ (v_k >> 1). The map
+/// is linear over GF(2), so it is four lookups, one per byte of `i`, in tables built at compile
+/// time (4 KiB) — no data-dependent branch per bit.
+pub fn sobol_1(i: u32) -> u32 {
+    let t = &SOBOL_1_BYTES;
+    t[0][(i & 0xff) as usize]
+        ^ t[1][((i >> 8) & 0xff) as usize]
+        ^ t[2][((i >> 16) & 0xff) as usize]
+        ^ t[3][(i >> 24) as usize]
+}
+
+/// The generator matrix's 32 columns.
+const fn sobol_1_columns() -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut c = 1u32 << 31;
+    let mut k = 0;
+    while k < 32 {
+        v[k] = c;
+        c ^= c >> 1;
+        k += 1;
+    }
+    v
+}
+
+static SOBOL_1_BYTES: [[u32; 256]; 4] = sobol_1_tables();
+
+const fn sobol_1_tables() -> [[u32; 256]; 4] {
+    let v = sobol_1_columns();
+    let mut t = [[0u32; 256]; 4];
+    let mut byte = 0;
+    while byte < 4 {
+        let mut b = 0;
+        while b < 256 {
+            let mut x = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if b & (1 << bit) != 0 {
+                    x ^= v[byte * 8 + bit];
+                }
+                bit += 1;
+            }
+            t[byte][b] = x;
+            b += 1;
+        }
+        byte += 1;
+    }
+    t
+}
+
+/// [`sobol_1`] bit by bit, the definition the tables are checked against.
+pub fn sobol_1_reference(mut i: u32) -> u32 {
     let mut v = 1u32 << 31;
     let mut x = 0;
     while i != 0 {
@@ -35,13 +84,19 @@ pub fn sobol_1(mut i: u32) -> u32 {
 /// carry comes from below), xor with the word times an even constant (its bit p depends on
 /// bits below p), multiplying by an odd constant — and so is their composition. Applied to a
 /// bit-reversed fraction it is a nested uniform scramble: digit k is flipped by a hash of the
-/// digits before it (Laine & Karras 2011; Burley 2020). The seed's four words enter as
-/// additive and multiplicative constants.
+/// digits before it (Laine & Karras 2011; Burley 2020). Four 32-bit words of a hash of the
+/// seed enter as additive and multiplicative constants.
 fn lower_triangular_hash(mut x: u32, seed: u64) -> u32 {
+    // One 64-bit hash of the seed gives the four constants (the second pair by a multiply,
+    // which keeps them well mixed at the cost of one instruction instead of another hash).
     let s = mix64(seed);
-    let (a, b) = (s as u32, (s >> 32) as u32);
-    let t = mix64(s);
-    let (c, d) = (t as u32, (t >> 32) as u32);
+    let t = s.wrapping_mul(0xD1B5_4A32_D192_ED03);
+    let (a, b, c, d) = (
+        s as u32,
+        (s >> 32) as u32,
+        (t >> 32) as u32,
+        t as u32 ^ (s >> 17) as u32,
+    );
     x = x.wrapping_add(a);
     x ^= x.wrapping_mul(0x6d2b_79f4);
     x = x.wrapping_mul(b | 1);
@@ -64,6 +119,28 @@ pub fn owen(x: u32, seed: u64) -> u32 {
 /// A 32-bit fraction as an f32 in [0, 1): its top 24 bits, exactly representable.
 pub fn to_unit(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// One randomized point of a (0,2)-sequence pair, as used by every layout group: the index `i`
+/// Owen-shuffled with `seed`, then Sobol dimensions 0 and 1 of it, each Owen-scrambled with its
+/// own seed derived from `seed`. Equal to
+/// `[owen(sobol_0(j), seed ^ A), owen(sobol_1(j), seed ^ B)]` with `j = owen(i, seed)`, with
+/// the bit reversals that cancel left out (owen ∘ sobol_0 = reverse ∘ hash, since sobol_0 is
+/// itself a reversal). `pair` false: only the first coordinate.
+pub fn scrambled_pair(i: u32, seed: u64, pair: bool) -> [f32; 2] {
+    scrambled_point(owen(i, seed), seed, pair)
+}
+
+/// Sobol point `j` (dimensions 0 and 1, or 0 alone), each coordinate Owen-scrambled with a seed
+/// derived from `seed`; no index shuffle (Z-Sobol permutes its index itself).
+pub fn scrambled_point(j: u32, seed: u64, pair: bool) -> [f32; 2] {
+    let x = lower_triangular_hash(j, seed ^ 0xa5a5_0001).reverse_bits();
+    let y = if pair {
+        owen(sobol_1(j), seed ^ 0xa5a5_0002)
+    } else {
+        0
+    };
+    [to_unit(x), to_unit(y)]
 }
 
 /// Interleaves the bits of x (even positions) and y (odd positions).
@@ -124,6 +201,21 @@ pub fn is_02_net(points: &[[u32; 2]]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tables_and_shortcuts_match_their_definitions() {
+        let mut x = 0x1234_5678u32;
+        for i in (0..5000u32).chain([u32::MAX, 1 << 31, 0xdead_beef]) {
+            assert_eq!(sobol_1(i), sobol_1_reference(i), "{i}");
+            x = x.wrapping_mul(747796405).wrapping_add(2891336453);
+            for (i, seed) in [(i, 9u64), (x, x as u64)] {
+                let j = owen(i, seed);
+                let [a, b] = scrambled_pair(i, seed, true);
+                assert_eq!(a, to_unit(owen(sobol_0(j), seed ^ 0xa5a5_0001)));
+                assert_eq!(b, to_unit(owen(sobol_1(j), seed ^ 0xa5a5_0002)));
+            }
+        }
+    }
 
     #[test]
     fn sobol_first_points() {

@@ -14,17 +14,22 @@
 //! a fresh randomization (an epoch in the seed).
 
 use super::generator::{SampleGenerator, SampleKey, Setup};
-use super::qmc::{owen, sobol_0, sobol_1, to_unit};
+use super::qmc::scrambled_pair;
 use crate::math::mix64;
 
 pub struct Sobol;
 
 pub static SOBOL: Sobol = Sobol;
 
-/// The seed of layout group `group` of a sample key's sequence (index epoch included).
-pub fn group_seed(key: &SampleKey, group: usize, epoch: u64) -> u64 {
-    let base = mix64(mix64(key.seed ^ 0x50b0_1d5e_ed00_0001) ^ key.strategy);
-    mix64(mix64(base ^ key.pixel) ^ (group as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ epoch)
+/// The seed every group of a sample key's sequence derives from (index epoch included).
+pub fn sequence_seed(key: &SampleKey, epoch: u64) -> u64 {
+    mix64(mix64(key.seed ^ 0x50b0_1d5e_ed00_0001) ^ key.strategy ^ mix64(key.pixel ^ (epoch << 40)))
+}
+
+/// The seed of layout group `group` of the sequence seeded `sequence` (`owen` hashes it again,
+/// so a distinct odd multiple per group suffices).
+pub fn group_seed(sequence: u64, group: usize) -> u64 {
+    sequence ^ (group as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 /// Fills `out` group by group from `setup.layout`: the point of index `i` (of one epoch) with
@@ -34,11 +39,11 @@ pub fn fill_groups(setup: &Setup, i: u32, seed_of: impl Fn(usize) -> u64, out: &
         if start >= out.len() {
             break;
         }
-        let seed = seed_of(g);
-        let j = owen(i, seed);
-        out[start] = to_unit(owen(sobol_0(j), seed ^ 0xa5a5_0001));
-        if d.width == 2 && start + 1 < out.len() {
-            out[start + 1] = to_unit(owen(sobol_1(j), seed ^ 0xa5a5_0002));
+        let pair = d.width == 2 && start + 1 < out.len();
+        let [x, y] = scrambled_pair(i, seed_of(g), pair);
+        out[start] = x;
+        if pair {
+            out[start + 1] = y;
         }
     }
 }
@@ -53,7 +58,7 @@ impl SampleGenerator for Sobol {
     }
 
     fn fill(&self, setup: &Setup, key: SampleKey, out: &mut [f32]) {
-        let epoch = key.index >> 32;
-        fill_groups(setup, key.index as u32, |g| group_seed(&key, g, epoch), out);
+        let sequence = sequence_seed(&key, key.index >> 32);
+        fill_groups(setup, key.index as u32, |g| group_seed(sequence, g), out);
     }
 }

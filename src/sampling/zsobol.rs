@@ -18,7 +18,7 @@
 //! the coordinates' scrambles, so large images still get distinct points.
 
 use super::generator::{SampleGenerator, SampleKey, Setup};
-use super::qmc::{ceil_log2, morton_2d, owen, sobol_0, sobol_1, to_unit};
+use super::qmc::{ceil_log2, morton_2d, owen, scrambled_point};
 use crate::math::mix64;
 
 pub struct ZSobol;
@@ -53,32 +53,36 @@ const fn permutations() -> [[u8; 4]; 24] {
     out
 }
 
-/// The permuted global index of sample `index` of pixel (x, y) for one dimension group: Morton
+/// The permuted global index of sample `index` of the pixel of Morton code `morton` for one
+/// dimension group: Morton
 /// digits (above bit `log2_block`) permuted in base 4 from the top, then the index digits
 /// Owen-shuffled in base 2 (seeded by the permuted pixel part, so pixels differ).
 pub fn permuted_index(
-    x: u32,
-    y: u32,
+    morton: u64,
     log2_res: u32,
     log2_block: u32,
     index: u64,
     group_seed: u64,
 ) -> u64 {
-    let morton = morton_2d(x, y);
     let mut pixel_part = 0u64;
     for k in (0..log2_res).rev() {
         let digit = (morton >> (2 * k)) & 3;
         let higher = morton >> (2 * k + 2);
-        // The digit's position enters the hash, so equal prefixes at different depths differ.
-        let h = mix64(higher ^ group_seed ^ ((k as u64 + 1) << 58));
-        let p = PERMUTATIONS[(h % 24) as usize];
+        // A one-multiply hash of the prefix, the depth and the group's (already hashed) seed,
+        // its top bits mapped onto 0..24 by a multiply (Lemire's range reduction). The digits'
+        // hashes are independent of each other, so they pipeline.
+        let h = ((higher ^ ((k as u64 + 1) << 58)) ^ group_seed)
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (group_seed >> 23);
+        let h = (h ^ (h >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        let p = PERMUTATIONS[(((h >> 32) * 24) >> 32) as usize];
         pixel_part |= (p[digit as usize] as u64) << (2 * k);
     }
     let mask = if log2_block >= 64 { u64::MAX } else { (1u64 << log2_block) - 1 };
     let within = index & mask;
     // Index digits: an Owen shuffle of the low 32 bits (log2_block ≤ 32 here), seeded by the
     // permuted pixel code so each pixel's order differs.
-    let shuffled = owen(within as u32, mix64(group_seed ^ pixel_part)) as u64 & mask;
+    let shuffled = owen(within as u32, group_seed ^ pixel_part.wrapping_mul(0xD6E8_FEB8_6659_FD93)) as u64 & mask;
     (pixel_part << log2_block) | shuffled
 }
 
@@ -102,6 +106,7 @@ impl SampleGenerator for ZSobol {
             .map_or(DEFAULT_LOG2_BLOCK, |n| ceil_log2(n).min(32));
         // Past the block the index wraps into a fresh randomization.
         let epoch = if log2_block >= 64 { 0 } else { key.index >> log2_block };
+        let morton = morton_2d(x, y);
         let run = mix64(mix64(key.seed ^ 0x250b_01e5_0000_0002) ^ key.strategy ^ epoch);
         for (start, d) in setup.layout.offsets() {
             if start >= out.len() {
@@ -109,13 +114,19 @@ impl SampleGenerator for ZSobol {
             }
             // pbrt keys a group by its first dimension; so does this (stable under layout edits
             // after it).
-            let gseed = mix64(run ^ (start as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-            let global = permuted_index(x, y, log2_res, log2_block, key.index, gseed);
+            // (`run` is a full hash; the scrambles hash their seeds again.)
+            let gseed = run ^ (start as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            let global = permuted_index(morton, log2_res, log2_block, key.index, gseed);
             let i = global as u32;
-            let s = mix64(gseed ^ (global >> 32));
-            out[start] = to_unit(owen(sobol_0(i), s ^ 0x5a5a_0001));
-            if d.width == 2 && start + 1 < out.len() {
-                out[start + 1] = to_unit(owen(sobol_1(i), s ^ 0x5a5a_0002));
+            let s = match global >> 32 {
+                0 => gseed,
+                hi => mix64(gseed ^ hi),
+            };
+            let pair = d.width == 2 && start + 1 < out.len();
+            let [u, v] = scrambled_point(i, s, pair);
+            out[start] = u;
+            if pair {
+                out[start + 1] = v;
             }
         }
     }
