@@ -44,7 +44,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
     // --time and --runs are bounded by their parsers; their seeds together, here, before
     // anything is loaded.
     options::check_seeds(a.common.seed, a.runs)?;
-    compare::resolve_samplers(&a.sampler)?;
+    let samplers = compare::resolve_samplers(&a.sampler)?.len() as u64;
     let (pool, threads) = pool(a.common.threads)?;
     let (scene, isa) = load_with(&a.common)?;
     scene.scene.require_light_power()?;
@@ -69,13 +69,19 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         skipped.retain(|k| wanted.contains(&k.name));
     }
     // References (one per integrand), the film's mean, its variance and a checkpoint's mean;
-    // then per (strategy, run) its rows and summary input, about 3 kB.
+    // then per (strategy, sampler, run) its rows and summary input, about 3 kB.
     let integrands = strategy::integrands(&scene).len() as u64;
     check_image_memory(&scene, integrands + 3)?;
     crate::bounded::check_memory(
-        || format!("--runs {} (strategies: {})", a.runs, run.len()),
+        || {
+            format!(
+                "--runs {} (strategies: {}, samplers: {samplers})",
+                a.runs,
+                run.len()
+            )
+        },
         image_memory(&scene, integrands + 3).saturating_add(crate::bounded::bytes(
-            a.runs as u64 * run.len() as u64,
+            (a.runs as u64 * run.len() as u64).saturating_mul(samplers),
             3000,
         )),
     )?;
