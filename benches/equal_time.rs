@@ -59,6 +59,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             threads,
             runs,
             isa: dibench::simd::Isa::detect()?.name().to_string(),
+            samplers: Vec::new(),
         };
         let references = compare::References { images };
         let run_dir = compare::create_run_dir(&out, &scene.scene.name, 1)?;
@@ -75,7 +76,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             println!(
                 "  {:<18} {:>12.4e} {:>12.4e} {:>10.2e}",
                 r.strategy,
-                r.predicted_rmse,
+                r.predicted_rmse.unwrap_or(f64::NAN),
                 r.rmse_mean,
                 r.rmse_ci95.unwrap_or(0.0)
             );

@@ -3,8 +3,9 @@
 //! the one test every such check makes: [`PointCase`] and [`mean_test`].
 
 use crate::prepare::PreparedScene;
-use crate::stats::{Welford, z_critical};
-use crate::strategy::estimate::estimate_at;
+use crate::sampling::SampleGenerator;
+use crate::stats::{Welford, t_critical, z_critical};
+use crate::strategy::estimate::{estimate_at, estimate_at_with};
 use crate::strategy::{ShadingPoint, Strategy};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -43,7 +44,90 @@ pub struct PointCase<'a> {
     pub expected: [f64; 3],
 }
 
+/// Independent replicates (seeds) the checks of a non-independent generator average over.
+pub const REPLICATES: u64 = 32;
+
 impl PointCase<'_> {
+    /// [`Self::check`] with samples from `generator`. An independent generator is checked as
+    /// there; any other by [`REPLICATES`] independently randomized replicates (seeds seed,
+    /// seed + 1, …) of `samples / REPLICATES` samples each (rounded down to a power of two, so
+    /// a replicate is a whole net), t-testing the mean of the replicate means with the
+    /// standard error across replicates — the only honest one for correlated samples.
+    pub fn check_with(
+        &self,
+        generator: &dyn SampleGenerator,
+        strategy: &dyn Strategy,
+        samples: u64,
+        seed: u64,
+        alpha: f64,
+        detectable: f64,
+    ) -> Result<(), String> {
+        if generator.independent_samples() {
+            return self.check_stats(
+                strategy,
+                estimate_at_with(generator, self.scene, strategy, &self.point, samples, seed),
+                z_critical(alpha),
+                detectable,
+                generator.name(),
+            );
+        }
+        let per = 1u64 << (63 - (samples / REPLICATES).max(1).leading_zeros());
+        let mut means = [Welford::default(); 3];
+        for r in 0..REPLICATES {
+            let st = estimate_at_with(
+                generator,
+                self.scene,
+                strategy,
+                &self.point,
+                per,
+                seed.wrapping_add(r),
+            );
+            for c in 0..3 {
+                means[c].add(st[c].mean);
+            }
+        }
+        // The replicates' Welford: its std_error is that of the mean of REPLICATES means.
+        self.check_stats(
+            strategy,
+            means,
+            t_critical(alpha, (REPLICATES - 1) as f64),
+            detectable,
+            generator.name(),
+        )
+    }
+
+    fn check_stats(
+        &self,
+        strategy: &dyn Strategy,
+        stats: [Welford; 3],
+        z_crit: f64,
+        detectable: f64,
+        generator: &str,
+    ) -> Result<(), String> {
+        let name = format!("{} ({generator})", strategy.name());
+        for (c, st) in stats.iter().enumerate() {
+            let t = mean_test(st, self.expected[c], z_crit);
+            if !t.passed {
+                return Err(format!(
+                    "{name}, channel {c}: mean {:.6e} vs closed form {:.6e} (se {:.2e}, z = {:.2}, critical {z_crit:.2})",
+                    t.mean,
+                    t.expected,
+                    t.std_error,
+                    t.z.unwrap_or(f64::INFINITY)
+                ));
+            }
+            if t.std_error * z_crit >= detectable * t.expected.abs() {
+                return Err(format!(
+                    "{name}: standard error {:.2e} too large to detect a {}% bias of {:.3e}",
+                    t.std_error,
+                    detectable * 100.0,
+                    t.expected
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `samples` of `strategy` at the point, each channel z-tested at significance `alpha`;
     /// also an error when the test is too blunt to see a relative bias of `detectable` (its
     /// standard error is too large for the closed form), so a pass means something.

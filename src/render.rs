@@ -12,7 +12,7 @@ use crate::geometry::Ray;
 use crate::prepare::{PreparedScene, SceneView};
 use crate::sampling::generator::MAX_DIMENSIONS;
 use crate::sampling::stream::name_id;
-use crate::sampling::{Dims, GENERATORS, Layout, SampleGenerator, SampleKey};
+use crate::sampling::{Dims, GENERATORS, SampleGenerator, SampleKey, Setup};
 use crate::scene::Camera;
 use crate::strategy::{EmissionProbe, Estimator, PassPoints, Probes, ShadingPoint, Strategy};
 use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
@@ -24,6 +24,8 @@ pub struct Renderer<'a> {
     pub view: SceneView<'a>,
     estimator: Box<dyn Estimator + 'a>,
     generator: &'a dyn SampleGenerator,
+    /// What the generator knows of this render (layout, spp if fixed, image size).
+    setup: Setup,
     pub seed: u64,
     strategy_id: u64,
     /// Camera dimensions plus the estimator's.
@@ -56,11 +58,26 @@ impl<'a> Renderer<'a> {
         Self::with_generator(scene, strategy, seed, GENERATORS[0])
     }
 
+    /// `strategy` drawing from `generator`, with no sample count known up front (a time
+    /// budget); see [`Self::with_sampler`].
     pub fn with_generator(
         scene: &'a PreparedScene,
         strategy: &dyn Strategy,
         seed: u64,
         generator: &'a dyn SampleGenerator,
+    ) -> Result<Self> {
+        Self::with_sampler(scene, strategy, seed, generator, None)
+    }
+
+    /// `strategy` drawing from `generator`, told the number of passes `spp` the render will
+    /// take when it is fixed (a stratified generator needs it); an error when the strategy does
+    /// not apply or the generator cannot serve this render.
+    pub fn with_sampler(
+        scene: &'a PreparedScene,
+        strategy: &dyn Strategy,
+        seed: u64,
+        generator: &'a dyn SampleGenerator,
+        spp: Option<u64>,
     ) -> Result<Self> {
         let integrand = strategy.integrand();
         let view = scene.view(integrand);
@@ -71,22 +88,36 @@ impl<'a> Renderer<'a> {
                 scene.scene.name
             ))
         })?;
-        let dims = Layout::camera().len() + estimator.layout().len();
+        let setup = Setup::image(
+            estimator.layout(),
+            spp,
+            scene.scene.width,
+            scene.scene.height,
+        );
+        let dims = setup.layout.len();
         if dims > MAX_DIMENSIONS {
             return Err(Error::Usage(format!(
                 "strategy `{name}` lays out {dims} sample dimensions; at most {MAX_DIMENSIONS} are supported"
             )));
         }
+        generator
+            .check(&setup)
+            .map_err(|why| Error::Usage(format!("--sampler {}: {why}", generator.name())))?;
         Ok(Renderer {
             scene,
             view,
             estimator,
             generator,
+            setup,
             seed,
             strategy_id: name_id(&name),
             dims,
             direct: integrand.is_direct(),
         })
+    }
+
+    pub fn generator(&self) -> &dyn SampleGenerator {
+        self.generator
     }
 
     pub fn estimator(&self) -> &dyn Estimator {
@@ -171,6 +202,7 @@ impl<'a> Renderer<'a> {
                 let pixel = y * w + x;
                 let values = &mut out.values[lane][..self.dims];
                 self.generator.fill(
+                    &self.setup,
                     SampleKey {
                         seed: self.seed,
                         strategy: self.strategy_id,

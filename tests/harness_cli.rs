@@ -97,7 +97,7 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
          rmse_ci95,rmse_debiased,mse_debiased_mean,mse_debiased_ci95,relmse_mean,relmse_ci95,\
          relmse_debiased_mean,relmse_debiased_ci95,efficiency,predicted_rmse,\
          reference_noise_floor,slope_time_mean,slope_time_ci95,slope_spp_mean,welch_p_vs_best,\
-         holm_p_vs_best,vs_best"
+         holm_p_vs_best,vs_best,sampler"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{summary}");
@@ -564,4 +564,114 @@ fn warp_retests_before_it_says_failed() {
     );
     assert_eq!(code, 3, "{stderr}");
     assert!(stderr.contains("at 100000 samples and p ="), "{stderr}");
+}
+
+/// `--sampler independent,sobol`: every strategy runs with both; results.csv and summary.csv
+/// carry the sampler column for both, the Sobol rows leave predicted_rmse empty (and write no
+/// variance image), the independent ones keep it; the console and run.json say why once; the
+/// plot labels both. Bad samplers are usage errors naming the flag; stratified is refused at
+/// equal time, saying it needs --spp.
+#[test]
+fn compare_with_two_samplers() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let args = |sampler: &str| -> Vec<String> {
+        [
+            "compare",
+            "tiny.toml",
+            "--runs",
+            "2",
+            "--time",
+            "0.05",
+            "--reference-spp",
+            "64",
+            "--strategies",
+            "light,cosine",
+            "--threads",
+            "1",
+            "--sampler",
+            sampler,
+            "--out",
+            "out",
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    let run = |sampler: &str| {
+        let a = args(sampler);
+        let a: Vec<&str> = a.iter().map(|s| s.as_str()).collect();
+        dibench(&a, dir.path())
+    };
+    let (code, stdout, stderr) = run("independent,sobol");
+    assert_eq!(code, 0, "{stderr}");
+    assert_eq!(
+        stdout.matches("predicted_rmse is left empty").count(),
+        1,
+        "{stdout}"
+    );
+    let runs = run_dirs(&dir.path().join("out/tiny"));
+    let run_dir = &runs[0];
+    let results = std::fs::read_to_string(run_dir.join("results.csv")).unwrap();
+    assert!(results.lines().next().unwrap().ends_with(",relmse,sampler"));
+    for s in ["light", "cosine"] {
+        for g in ["independent", "sobol"] {
+            assert!(
+                results
+                    .lines()
+                    .any(|l| l.contains(&format!(",{s},")) && l.ends_with(&format!(",{g}"))),
+                "no {s} × {g} rows:\n{results}"
+            );
+        }
+        assert!(run_dir.join(format!("{s}.exr")).is_file());
+        assert!(run_dir.join(format!("{s}.variance.exr")).is_file());
+        assert!(run_dir.join(format!("{s}.sobol.exr")).is_file());
+        assert!(!run_dir.join(format!("{s}.sobol.variance.exr")).exists());
+    }
+    let summary = std::fs::read_to_string(run_dir.join("summary.csv")).unwrap();
+    let mut lines = summary.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 4, "{summary}");
+    for r in &rows {
+        let predicted = r[col("predicted_rmse")];
+        match r[col("sampler")] {
+            "independent" => assert!(predicted.parse::<f64>().unwrap() > 0.0, "{summary}"),
+            "sobol" => assert_eq!(predicted, "", "a QMC row predicted: {summary}"),
+            other => panic!("sampler {other}"),
+        }
+        assert!(!r[col("slope_time_mean")].is_empty(), "{summary}");
+    }
+    // One Holm family over the four (strategy, sampler) pairs: one best.
+    assert_eq!(
+        rows.iter().filter(|r| r[col("vs_best")] == "best").count(),
+        1
+    );
+    let meta = std::fs::read_to_string(run_dir.join("run.json")).unwrap();
+    assert!(
+        meta.contains("\"samplers\"") && meta.contains("sampler_note"),
+        "{meta}"
+    );
+    let (code, _, stderr) = dibench(&["plot", run_dir.to_str().unwrap()], dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    let svg = std::fs::read_to_string(run_dir.join("plots/rmse_vs_time.svg")).unwrap();
+    assert!(svg.contains("light [sobol]") && svg.contains("light [independent]"));
+
+    for bad in ["bogus", "independent,bogus", ""] {
+        let (code, _, stderr) = run(bad);
+        assert_ne!(code, 0, "--sampler {bad:?} accepted");
+        assert!(stderr.contains("--sampler"), "{bad:?}: {stderr}");
+        if !bad.is_empty() {
+            assert!(
+                stderr.contains("zsobol"),
+                "the generators are not listed: {stderr}"
+            );
+        }
+    }
+    let (code, _, stderr) = run("stratified");
+    assert_ne!(code, 0);
+    assert!(
+        stderr.contains("--sampler stratified") && stderr.contains("--spp"),
+        "{stderr}"
+    );
 }

@@ -33,6 +33,11 @@ pub struct CompareArgs {
     /// confidence intervals over them.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub runs: u32,
+    /// Comma-separated sample generators; every strategy runs with each
+    /// (independent, stratified, sobol, zsobol; stratified needs a fixed sample count, which
+    /// an equal-time run does not have, and is refused). References stay independent.
+    #[arg(long, value_delimiter = ',', default_value = "independent")]
+    pub sampler: Vec<String>,
     /// Run the pilots only and print each reference's plan (its strategy, target floor,
     /// predicted samples and time, and whether `--reference-cap` would end it first); render
     /// nothing and write nothing.
@@ -44,6 +49,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
     // --time and --runs are bounded by their parsers; their seeds together, here, before
     // anything is loaded.
     options::check_seeds(a.common.seed, a.runs)?;
+    let samplers = compare::resolve_samplers(&a.sampler)?.len() as u64;
     let (pool, threads) = pool(a.common.threads)?;
     let (scene, isa) = load_with(&a.common)?;
     scene.scene.require_light_power()?;
@@ -68,13 +74,19 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         skipped.retain(|k| wanted.contains(&k.name));
     }
     // References (one per integrand), the film's mean, its variance and a checkpoint's mean;
-    // then per (strategy, run) its rows and summary input, about 3 kB.
+    // then per (strategy, sampler, run) its rows and summary input, about 3 kB.
     let integrands = strategy::integrands(&scene).len() as u64;
     check_image_memory(&scene, integrands + 3)?;
     crate::bounded::check_memory(
-        || format!("--runs {} (strategies: {})", a.runs, run.len()),
+        || {
+            format!(
+                "--runs {} (strategies: {}, samplers: {samplers})",
+                a.runs,
+                run.len()
+            )
+        },
         image_memory(&scene, integrands + 3).saturating_add(crate::bounded::bytes(
-            a.runs as u64 * run.len() as u64,
+            (a.runs as u64 * run.len() as u64).saturating_mul(samplers),
             3000,
         )),
     )?;
@@ -144,6 +156,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
             threads,
             runs: a.runs,
             isa: isa.to_string(),
+            samplers: a.sampler.clone(),
         };
         let report = compare::run(&scene, &run, skipped, &references, &run_dir, &opts)?;
         // The warnings, then the report, whose ranked table comes last.

@@ -14,6 +14,7 @@ use crate::output::store::Store;
 use crate::output::{write_csv, write_exr};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
+use crate::sampling::{SampleGenerator, Setup};
 use crate::strategy::{Integrand, Skipped, Strategy};
 use serde::Deserialize;
 use serde::Serialize;
@@ -33,6 +34,9 @@ pub struct CompareOptions {
     pub runs: u32,
     /// The ISA path the tracer runs (`avx2`, `portable`, ... or `scalar`), for the metadata.
     pub isa: String,
+    /// The sample generators every strategy runs with (`--sampler`, names in
+    /// `sampling::GENERATORS`); empty means the default (independent) alone.
+    pub samplers: Vec<String>,
 }
 
 impl CompareOptions {
@@ -41,8 +45,66 @@ impl CompareOptions {
     pub fn check(&self) -> Result<()> {
         super::options::check_seconds("--time", self.time_s)?;
         super::options::check_at_least_one("--runs", self.runs as u64)?;
-        super::options::check_seeds(self.seed, self.runs)
+        super::options::check_seeds(self.seed, self.runs)?;
+        self.generators().map(|_| ())
     }
+
+    /// The generators of `samplers` ([`resolve_samplers`]).
+    pub fn generators(&self) -> Result<Vec<&'static dyn SampleGenerator>> {
+        resolve_samplers(&self.samplers)
+    }
+}
+
+/// The generators named (the default one when `names` is empty), each checked against an
+/// equal-time budget: it does not know the sample count, which stratification needs. A
+/// usage error names `--sampler` and lists the generators.
+pub fn resolve_samplers(names: &[String]) -> Result<Vec<&'static dyn SampleGenerator>> {
+    if names.is_empty() {
+        return Ok(vec![crate::sampling::GENERATORS[0]]);
+    }
+    let mut out: Vec<&'static dyn SampleGenerator> = Vec::new();
+    for name in names {
+        let g = crate::sampling::generator(name.trim()).ok_or_else(|| {
+            Error::Usage(format!(
+                "--sampler: unknown sample generator `{name}` (known: {})",
+                crate::sampling::generator_names()
+            ))
+        })?;
+        // Under a time budget the sample count per pixel is not known up front.
+        let probe = Setup::image(crate::sampling::Layout::default(), None, 1, 1);
+        if let Err(why) = g.check(&probe) {
+            return Err(Error::Usage(format!(
+                "--sampler {}: {why}; `compare` runs at equal time (--time), where it is not \
+                 known, so leave `{}` out of --sampler",
+                g.name(),
+                g.name()
+            )));
+        }
+        if !out.iter().any(|o| o.name() == g.name()) {
+            out.push(g);
+        }
+    }
+    Ok(out)
+}
+
+/// What summary.csv, run.json and the console say once when a non-independent generator ran.
+pub const QMC_NOTE: &str = "predicted_rmse is left empty and no <strategy>.<sampler>.variance.exr \
+    is written for a non-independent sampler: its samples within a pixel are correlated, so the \
+    per-pixel variance across passes is not the variance of the mean; errors, intervals, tests \
+    and slopes are across runs (independent seeds), which stay valid (docs/samplers.md)";
+
+/// The file stem of a (strategy, sampler) run's images: the strategy's name for the
+/// independent generator (as before the sampler axis), `<strategy>.<sampler>` otherwise.
+pub fn image_stem(strategy: &str, sampler: &str) -> String {
+    if sampler == crate::sampling::GENERATORS[0].name() {
+        strategy.to_string()
+    } else {
+        format!("{strategy}.{sampler}")
+    }
+}
+
+fn default_sampler() -> String {
+    crate::sampling::GENERATORS[0].name().to_string()
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -59,6 +121,10 @@ pub struct ResultRow {
     pub spp: u64,
     pub rmse: f64,
     pub relmse: f64,
+    /// The sample generator (`--sampler`), appended last so earlier columns keep their
+    /// positions; a results.csv written before the column existed reads as `independent`.
+    #[serde(default = "default_sampler")]
+    pub sampler: String,
 }
 
 #[derive(Serialize)]
@@ -75,6 +141,9 @@ struct RunMeta<'a> {
     seeds: Vec<u64>,
     budget_s: f64,
     strategies: Vec<String>,
+    samplers: Vec<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    sampler_note: Option<&'static str>,
     skipped: &'a [Skipped],
     reference_spp: &'a [(String, u64)],
     reference_noise_floor: &'a [(String, Option<f64>)],
@@ -85,6 +154,8 @@ struct RunMeta<'a> {
     /// adds `status` (`running`, `complete`, `interrupted`, `failed`, `unfinished`), whether the
     /// run was interrupted, and the error that ended it.
     completed: Vec<(String, u32)>,
+    /// The same pairs' samplers, in the same order.
+    completed_samplers: Vec<String>,
 }
 
 /// What one strategy's run leaves: the mean and variance images, the rows, and the final
@@ -93,7 +164,9 @@ pub struct StrategyRun {
     pub image: Image,
     pub variance: Image,
     pub rows: Vec<ResultRow>,
-    pub mean_sample_variance: f64,
+    /// None for a generator whose samples are not independent (the across-pass variance is
+    /// then not the per-sample variance the prediction needs).
+    pub mean_sample_variance: Option<f64>,
     /// An interrupt arrived before the budget was spent: the run is incomplete and must be
     /// discarded (its error is not comparable with the others').
     pub interrupted: bool,
@@ -111,14 +184,16 @@ pub struct StrategyRun {
 pub fn run_strategy(
     scene: &PreparedScene,
     strategy: &dyn Strategy,
+    generator: &dyn SampleGenerator,
     reference: &Image,
     opts: &CompareOptions,
     run: u32,
     mut on_progress: impl FnMut(Duration),
 ) -> Result<StrategyRun> {
     let seed = opts.seed.wrapping_add(run as u64);
-    let mut renderer = Renderer::new(scene, strategy, seed)?;
+    let mut renderer = Renderer::with_generator(scene, strategy, seed, generator)?;
     let name = strategy.name();
+    let sampler = generator.name().to_string();
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     // Validated where the options are built (`--time`); saturating for other callers.
     let budget = Duration::try_from_secs_f64(opts.time_s).unwrap_or(Duration::MAX);
@@ -133,6 +208,7 @@ pub fn run_strategy(
         ResultRow {
             scene: scene.scene.name.clone(),
             strategy: name.clone(),
+            sampler: sampler.clone(),
             integrand: strategy.integrand().name().to_string(),
             backend: scene.tracer.name().to_string(),
             threads: opts.threads,
@@ -174,7 +250,9 @@ pub fn run_strategy(
         image: film.mean(),
         variance: film.variance_of_mean(),
         rows,
-        mean_sample_variance: film.mean_sample_variance(),
+        mean_sample_variance: generator
+            .independent_samples()
+            .then(|| film.mean_sample_variance()),
         interrupted,
     })
 }
@@ -191,6 +269,8 @@ pub struct CompareReport {
     pub seed: u64,
     pub time_s: f64,
     pub references: Vec<ReferenceUsed>,
+    /// Whether a non-independent generator ran (then [`QMC_NOTE`] is printed).
+    pub qmc: bool,
 }
 
 /// A reference a compare run measured against.
@@ -239,6 +319,9 @@ impl std::fmt::Display for CompareReport {
                 )?;
             }
         }
+        if self.qmc {
+            writeln!(f, "note: {QMC_NOTE}")?;
+        }
         writeln!(f, "results: {}", self.run_dir.display())?;
         // The table last, ranked by the debiased relMSE (see `summary`).
         let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
@@ -246,8 +329,9 @@ impl std::fmt::Display for CompareReport {
         let opt_e = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.3e}"));
         writeln!(
             f,
-            "{:<22} {:>9} {:>4} {:>8} {:>10} {:>9} {:>10} {:>10} {:>9} {:>6} {:>10} {:>10} vs_best (Holm)",
+            "{:<22} {:<11} {:>9} {:>4} {:>8} {:>10} {:>9} {:>10} {:>10} {:>9} {:>6} {:>10} {:>10} vs_best (Holm)",
             "strategy",
+            "sampler",
             "integrand",
             "runs",
             "spp",
@@ -263,8 +347,9 @@ impl std::fmt::Display for CompareReport {
         for r in &self.summary {
             writeln!(
                 f,
-                "{:<22} {:>9} {:>4} {:>8.0} {:>10.3e} {:>9} {:>10} {:>10.3e} {:>9} {:>6} {:>10.3e} {:>10} {}",
+                "{:<22} {:<11} {:>9} {:>4} {:>8.0} {:>10.3e} {:>9} {:>10} {:>10.3e} {:>9} {:>6} {:>10} {:>10} {}",
                 r.strategy,
+                r.sampler,
                 r.integrand,
                 r.runs,
                 r.spp_mean,
@@ -274,7 +359,7 @@ impl std::fmt::Display for CompareReport {
                 r.relmse_debiased_mean,
                 ci(r.relmse_debiased_ci95),
                 opt(r.slope_time_mean),
-                r.predicted_rmse,
+                opt_e(r.predicted_rmse),
                 opt_e(r.efficiency),
                 r.vs_best
             )?;
@@ -445,6 +530,8 @@ pub fn run(
     opts: &CompareOptions,
 ) -> Result<CompareReport> {
     opts.check()?;
+    let generators = opts.generators()?;
+    let qmc = generators.iter().any(|g| !g.independent_samples());
     if strategies.is_empty() {
         return Err(Error::Usage(format!(
             "scene `{}`: no strategy applies",
@@ -466,6 +553,8 @@ pub fn run(
             .collect(),
         budget_s: opts.time_s,
         strategies: strategies.iter().map(|s| s.name()).collect(),
+        samplers: generators.iter().map(|g| g.name().to_string()).collect(),
+        sampler_note: qmc.then_some(QMC_NOTE),
         skipped: &skipped,
         reference_spp: &references
             .images
@@ -481,18 +570,25 @@ pub fn run(
         rustc: RUSTC,
         commit: COMMIT,
         completed: Vec::new(),
+        completed_samplers: Vec::new(),
     };
     let dir = run_dir.path();
     run_dir.record(&meta, Status::Running)?;
     let mut rows = Vec::new();
     let mut finals = Vec::new();
     let budget_ms = (opts.time_s * 1000.0).ceil() as u64;
-    // Strategies interleaved within each run, so slow drifts in machine load spread over all.
+    // Strategies (and, within each, samplers) interleaved within each run, so slow drifts in
+    // machine load spread over all.
+    let pairs: Vec<(&Box<dyn Strategy>, &dyn SampleGenerator)> = strategies
+        .iter()
+        .flat_map(|s| generators.iter().map(move |g| (s, *g)))
+        .collect();
     for run in 0..opts.runs {
-        for s in strategies {
+        for &(s, g) in &pairs {
+            let stem = image_stem(&s.name(), g.name());
             let bar = progress_bar(
                 budget_ms,
-                format!("run {run} {:<10}", s.name()),
+                format!("run {run} {:<10}", stem),
                 "{prefix} [{bar:30}] {msg}",
             );
             let reference = references.get(s.integrand()).ok_or_else(|| {
@@ -502,7 +598,7 @@ pub fn run(
                     s.name()
                 ))
             })?;
-            let r = run_strategy(scene, s.as_ref(), &reference.image, opts, run, |t| {
+            let r = run_strategy(scene, s.as_ref(), g, &reference.image, opts, run, |t| {
                 bar.set_position(t.as_millis() as u64);
             })?;
             bar.finish_and_clear();
@@ -513,15 +609,16 @@ pub fn run(
                     write_csv(&dir.join("summary.csv"), &summarize(&finals, opts.time_s))?;
                 }
                 return Err(Error::Interrupted(format!(
-                    "compare kept {} finished strategy run(s) in {}; `{}` (run {run}) was discarded",
+                    "compare kept {} finished strategy run(s) in {}; `{stem}` (run {run}) was discarded",
                     meta.completed.len(),
                     dir.display(),
-                    s.name()
                 )));
             }
             if run == 0 {
-                write_exr(&dir.join(format!("{}.exr", s.name())), &r.image)?;
-                write_exr(&dir.join(format!("{}.variance.exr", s.name())), &r.variance)?;
+                write_exr(&dir.join(format!("{stem}.exr")), &r.image)?;
+                if g.independent_samples() {
+                    write_exr(&dir.join(format!("{stem}.variance.exr")), &r.variance)?;
+                }
             }
             let Some(last) = FinalRun::new(
                 &r.rows,
@@ -529,16 +626,14 @@ pub fn run(
                 reference.noise_floor,
                 reference.relmse_floor,
             ) else {
-                return Err(Error::Usage(format!(
-                    "`{}` (run {run}) left no rows",
-                    s.name()
-                )));
+                return Err(Error::Usage(format!("`{stem}` (run {run}) left no rows")));
             };
             finals.push(last);
             rows.extend(r.rows);
             write_csv(&dir.join("results.csv"), &rows)?;
             run_dir.keep();
             meta.completed.push((s.name().to_string(), run));
+            meta.completed_samplers.push(g.name().to_string());
             run_dir.record(&meta, Status::Running)?;
         }
     }
@@ -564,5 +659,6 @@ pub fn run(
                 noise_floor: r.noise_floor,
             })
             .collect(),
+        qmc,
     })
 }

@@ -13,8 +13,9 @@ pub const LEVEL: f64 = 0.95;
 #[derive(Clone, Debug)]
 pub struct FinalRun {
     pub row: ResultRow,
-    /// σ² of the 1-spp estimator, mean over pixels and channels.
-    pub mean_sample_variance: f64,
+    /// σ² of the 1-spp estimator, mean over pixels and channels; None for a generator whose
+    /// samples are not independent (no prediction is made for it).
+    pub mean_sample_variance: Option<f64>,
     pub reference_noise_floor: Option<f64>,
     /// What the reference's noise adds to relMSE in expectation (`metrics::relmse_floor`).
     pub reference_relmse_floor: f64,
@@ -27,7 +28,7 @@ impl FinalRun {
     /// The run's final row with the slopes of its checkpoint rows `rows`.
     pub fn new(
         rows: &[ResultRow],
-        mean_sample_variance: f64,
+        mean_sample_variance: Option<f64>,
         reference_noise_floor: Option<f64>,
         reference_relmse_floor: f64,
     ) -> Option<FinalRun> {
@@ -105,41 +106,52 @@ pub struct SummaryRow {
     pub efficiency: Option<f64>,
     /// √(σ² · (t/spp) / T + floor²): the RMSE expected from the per-sample variance σ², the
     /// measured cost per sample t/spp and the budget T, plus the reference's noise floor.
-    pub predicted_rmse: f64,
+    /// Empty for a non-independent sampler: that formula assumes independent samples, and
+    /// the across-pass variance of correlated samples is not σ².
+    pub predicted_rmse: Option<f64>,
     pub reference_noise_floor: Option<f64>,
     /// Slope of ln RMSE against ln time over each run's checkpoints, mean over runs, with its
     /// interval; and against ln spp. −½ for independent samples.
     pub slope_time_mean: Option<f64>,
     pub slope_time_ci95: Option<f64>,
     pub slope_spp_mean: Option<f64>,
-    /// Two-sided p-value of Welch's t-test of this strategy's per-run debiased relMSE against
-    /// the best strategy's (same integrand); empty for the best one and below 2 runs.
+    /// Two-sided p-value of Welch's t-test of this (strategy, sampler)'s per-run debiased
+    /// relMSE against the best one's (same integrand); empty for the best one and below 2 runs.
     pub welch_p_vs_best: Option<f64>,
     /// That p-value adjusted by Holm–Bonferroni over the family of every pairwise comparison
-    /// among the strategies of this integrand (so the choice of the best is covered too).
+    /// among the (strategy, sampler) pairs of this integrand (so the choice of the best is
+    /// covered too).
     pub holm_p_vs_best: Option<f64>,
     /// `best`; `worse` (Holm-adjusted p < 0.05) or `tie`; `one run: no test` below 2 runs.
     pub vs_best: String,
+    /// The sample generator; (strategy, sampler) is a run's identity. Appended last so the
+    /// earlier columns keep their positions.
+    pub sampler: String,
 }
 
-/// One summary row per (integrand, strategy), sorted per integrand by the ranking metric (the
-/// debiased relMSE), integrands in order of first appearance.
+/// A summary key: (integrand, strategy, sampler).
+type Key<'a> = (&'a str, &'a str, &'a str);
+
+fn key_of(f: &FinalRun) -> Key<'_> {
+    (
+        f.row.integrand.as_str(),
+        f.row.strategy.as_str(),
+        f.row.sampler.as_str(),
+    )
+}
+
+/// One summary row per (integrand, strategy, sampler), sorted per integrand by the ranking
+/// metric (the debiased relMSE), integrands in order of first appearance.
 pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
-    let mut keys: Vec<(&str, &str)> = Vec::new();
+    let mut keys: Vec<Key> = Vec::new();
     for f in finals {
-        let k = (f.row.integrand.as_str(), f.row.strategy.as_str());
+        let k = key_of(f);
         if !keys.contains(&k) {
             keys.push(k);
         }
     }
-    let group = |k: &(&str, &str)| -> Vec<&FinalRun> {
-        finals
-            .iter()
-            .filter(|f| (f.row.integrand.as_str(), f.row.strategy.as_str()) == *k)
-            .collect()
-    };
-    let debiased =
-        |k: &(&str, &str)| -> Vec<f64> { group(k).iter().map(|f| f.relmse_debiased()).collect() };
+    let group = |k: &Key| -> Vec<&FinalRun> { finals.iter().filter(|f| key_of(f) == *k).collect() };
+    let debiased = |k: &Key| -> Vec<f64> { group(k).iter().map(|f| f.relmse_debiased()).collect() };
     let mut rows: Vec<SummaryRow> = keys
         .iter()
         .map(|k| {
@@ -154,18 +166,21 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
             let slopes_n: Vec<f64> = g.iter().filter_map(|f| f.slope_spp).collect();
             let slope_t = (!slopes_t.is_empty()).then(|| mean_ci(&slopes_t, LEVEL));
             let floor = g[0].reference_noise_floor;
-            let predicted: Vec<f64> = g
+            // Only when every run has an independent-sample variance.
+            let predicted: Option<Vec<f64>> = g
                 .iter()
                 .map(|f| {
                     let cost = f.row.time_s / f.row.spp as f64;
                     let floor2 = f.reference_noise_floor.map_or(0.0, |x| x * x);
-                    (f.mean_sample_variance * cost / budget_s + floor2).sqrt()
+                    f.mean_sample_variance
+                        .map(|v| (v * cost / budget_s + floor2).sqrt())
                 })
                 .collect();
             SummaryRow {
                 scene: g[0].row.scene.clone(),
                 integrand: k.0.to_string(),
                 strategy: k.1.to_string(),
+                sampler: k.2.to_string(),
                 runs: g.len(),
                 budget_s,
                 time_s_mean: time.mean,
@@ -184,7 +199,7 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
                 relmse_debiased_mean: relmse_d.mean,
                 relmse_debiased_ci95: relmse_d.half_width,
                 efficiency: (relmse.mean > 0.0).then(|| 1.0 / (relmse.mean * time.mean)),
-                predicted_rmse: predicted.iter().sum::<f64>() / predicted.len() as f64,
+                predicted_rmse: predicted.map(|p| p.iter().sum::<f64>() / p.len() as f64),
                 reference_noise_floor: floor,
                 slope_time_mean: slope_t.as_ref().map(|m| m.mean),
                 slope_time_ci95: slope_t.and_then(|m| m.half_width),
@@ -203,37 +218,40 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
         }
     }
     for &integrand in &integrands {
-        let mine: Vec<(&str, &str)> = keys.iter().copied().filter(|k| k.0 == integrand).collect();
+        let mine: Vec<Key> = keys.iter().copied().filter(|k| k.0 == integrand).collect();
         // Best = lowest mean debiased relMSE.
         let Some(best) = rows
             .iter()
             .filter(|r| r.integrand == integrand)
             .min_by(|a, b| a.relmse_debiased_mean.total_cmp(&b.relmse_debiased_mean))
-            .map(|r| r.strategy.clone())
+            .map(|r| (r.strategy.clone(), r.sampler.clone()))
         else {
             continue;
         };
-        // The family: every pair of this integrand's strategies (Welch on per-run debiased
-        // relMSE), Holm-adjusted together; each row reports its pair with the best.
+        // The family: every pair of this integrand's (strategy, sampler) runs (Welch on
+        // per-run debiased relMSE), Holm-adjusted together; each row reports its pair with
+        // the best.
         let mut pairs = Vec::new();
         let mut raw = Vec::new();
         for i in 0..mine.len() {
             for j in i + 1..mine.len() {
                 if let Some(w) = welch_t_test(&debiased(&mine[i]), &debiased(&mine[j])) {
-                    pairs.push((mine[i].1, mine[j].1));
+                    pairs.push(((mine[i].1, mine[i].2), (mine[j].1, mine[j].2)));
                     raw.push(w.p_value);
                 }
             }
         }
         let adjusted = holm_adjust(&raw);
         for r in rows.iter_mut().filter(|r| r.integrand == integrand) {
-            if r.strategy == best {
+            let me = (r.strategy.as_str(), r.sampler.as_str());
+            let b = (best.0.as_str(), best.1.as_str());
+            if me == b {
                 r.vs_best = "best".into();
                 continue;
             }
-            let pair = pairs.iter().position(|&(a, b)| {
-                (a == r.strategy && b == best) || (b == r.strategy && a == best)
-            });
+            let pair = pairs
+                .iter()
+                .position(|&(x, y)| (x == me && y == b) || (y == me && x == b));
             match pair {
                 Some(k) => {
                     r.welch_p_vs_best = Some(raw[k]);
@@ -301,6 +319,7 @@ mod tests {
             row: ResultRow {
                 scene: "s".into(),
                 strategy: strategy.into(),
+                sampler: "independent".into(),
                 integrand: "direct".into(),
                 backend: "packet".into(),
                 threads: 1,
@@ -312,7 +331,7 @@ mod tests {
                 rmse: relmse.sqrt(),
                 relmse,
             },
-            mean_sample_variance: 0.01,
+            mean_sample_variance: Some(0.01),
             reference_noise_floor: Some(0.001),
             reference_relmse_floor: 0.0,
             slope_time: None,
@@ -338,7 +357,7 @@ mod tests {
         assert_eq!(get("a").runs, 5);
         assert!((get("a").relmse_mean - 1.0).abs() < 1e-12);
         // predicted √(σ²·c/T + floor²) with σ² = 0.01, c = 0.01 s, T = 1 s.
-        assert!((get("a").predicted_rmse - (1e-4f64 + 1e-6).sqrt()).abs() < 1e-12);
+        assert!((get("a").predicted_rmse.unwrap() - (1e-4f64 + 1e-6).sqrt()).abs() < 1e-12);
         assert!((get("a").efficiency.unwrap() - 1.0).abs() < 1e-12);
         assert!(noise_floor_warnings(&rows, 0.1).is_empty());
     }
@@ -424,5 +443,29 @@ mod tests {
         let rows = summarize(&[a, b], 1.0);
         assert_eq!(rows[0].strategy, "b", "sorted by the ranking metric");
         assert_eq!(rows[1].vs_best, "one run: no test");
+    }
+
+    /// The sampler is part of a row's identity: the same strategy with two samplers gives two
+    /// rows in one Holm family, and a non-independent sampler's row has no prediction.
+    #[test]
+    fn samplers_are_separate_rows_and_qmc_predicts_nothing() {
+        let mut finals = Vec::new();
+        for k in 0..4u32 {
+            let e = k as f64 * 0.01;
+            finals.push(fr("a", k, 1.0 + e));
+            let mut q = fr("a", k, 0.1 + e);
+            q.row.sampler = "sobol".into();
+            q.mean_sample_variance = None;
+            finals.push(q);
+        }
+        let rows = summarize(&finals, 1.0);
+        assert_eq!(rows.len(), 2);
+        assert_eq!(
+            (rows[0].sampler.as_str(), rows[0].vs_best.as_str()),
+            ("sobol", "best")
+        );
+        assert_eq!(rows[0].predicted_rmse, None);
+        assert_eq!(rows[1].vs_best, "worse");
+        assert!(rows[1].predicted_rmse.is_some() && rows[1].holm_p_vs_best.is_some());
     }
 }

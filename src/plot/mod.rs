@@ -45,19 +45,27 @@ struct Curve {
     points: Vec<(f64, f64, Option<f64>)>,
 }
 
+/// One curve per (strategy, sampler, integrand): the sampler is part of a run's identity, and
+/// part of the label when the run used more than one or a non-default one.
 fn curves(rows: &[ResultRow]) -> Vec<Curve> {
-    let mut keys: Vec<(String, String)> = Vec::new();
+    let mut keys: Vec<(String, String, String)> = Vec::new();
     for r in rows {
-        let k = (r.strategy.clone(), r.integrand.clone());
+        let k = (r.strategy.clone(), r.sampler.clone(), r.integrand.clone());
         if !keys.contains(&k) {
             keys.push(k);
         }
     }
+    let label_sampler = keys.iter().any(|k| k.1 != keys[0].1)
+        || keys
+            .iter()
+            .any(|k| k.1 != crate::sampling::GENERATORS[0].name());
     keys.into_iter()
-        .map(|(strategy, integrand)| {
+        .map(|(strategy, sampler, integrand)| {
             let mine: Vec<&ResultRow> = rows
                 .iter()
-                .filter(|r| r.strategy == strategy && r.integrand == integrand)
+                .filter(|r| {
+                    r.strategy == strategy && r.sampler == sampler && r.integrand == integrand
+                })
                 .collect();
             let mut cps: Vec<u32> = mine.iter().map(|r| r.checkpoint).collect();
             cps.sort_unstable();
@@ -87,6 +95,11 @@ fn curves(rows: &[ResultRow]) -> Vec<Curve> {
                     crate::harness::summary::convergence_slopes(&of_run).0
                 })
                 .collect();
+            let strategy = if label_sampler {
+                format!("{strategy} [{sampler}]")
+            } else {
+                strategy
+            };
             let name = if integrand == "direct" {
                 strategy
             } else {
@@ -336,12 +349,17 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
         });
     }
     // The names become file names in the run directory, and nothing outside it.
-    if let Some(r) = rows.iter().find(|r| {
-        r.strategy.is_empty() || Path::new(&r.strategy).file_name() != Some(r.strategy.as_ref())
-    }) {
+    let bad = |n: &str| n.is_empty() || Path::new(n).file_name() != Some(n.as_ref());
+    if let Some(r) = rows.iter().find(|r| bad(&r.strategy)) {
         return Err(Error::Parse {
             path: csv_path,
             message: format!("`{}` is not a strategy name", r.strategy),
+        });
+    }
+    if let Some(r) = rows.iter().find(|r| bad(&r.sampler)) {
+        return Err(Error::Parse {
+            path: csv_path,
+            message: format!("`{}` is not a sampler name", r.sampler),
         });
     }
     // Non-finite, zero or negative values have no place on a log axis: left out, and said.
@@ -371,10 +389,16 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
     svg_figure(&p, size, |root| draw_rmse(root, &c))?;
     written.push(p);
 
+    // One image per (strategy, sampler), by its file stem (`compare::image_stem`).
     let mut names: Vec<String> = Vec::new();
+    let mut independent: Vec<String> = Vec::new();
     for r in &rows {
-        if !names.contains(&r.strategy) {
-            names.push(r.strategy.clone());
+        let stem = crate::harness::compare::image_stem(&r.strategy, &r.sampler);
+        if !names.contains(&stem) {
+            if crate::sampling::generator(&r.sampler).is_none_or(|g| g.independent_samples()) {
+                independent.push(stem.clone());
+            }
+            names.push(stem);
         }
     }
     let images = strategy_images(run_dir, &names, "")?;
@@ -406,7 +430,29 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
     })?;
     written.push(p);
 
-    let variances = strategy_images(run_dir, &names, ".variance")?;
+    // The variance of the mean exists for independent samples only (a QMC run writes none:
+    // its across-pass variance is not the variance of the mean).
+    if independent.len() < names.len() {
+        crate::interrupt::note(&format!(
+            "plot: variance.png shows the {} independent-sample run(s) only; a non-independent \
+             sampler has no per-pixel variance of the mean",
+            independent.len()
+        ));
+    }
+    if independent.is_empty() {
+        return Ok(written);
+    }
+    let images: Vec<(String, Image)> = images
+        .into_iter()
+        .filter(|(n, _)| independent.contains(n))
+        .collect();
+    let variances = strategy_images(run_dir, &independent, ".variance")?;
+    let strip_size = {
+        let w = images.iter().fold(GAP as u64, |w, (_, i)| {
+            w + i.width as u64 * SCALE as u64 + GAP as u64
+        });
+        (w as u32, strip_size.1)
+    };
     for ((name, img), (_, var)) in images.iter().zip(&variances) {
         if (img.width, img.height) != (var.width, var.height) {
             return Err(Error::Parse {

@@ -24,12 +24,59 @@ pub struct SampleKey {
 /// refused when it is bound to a scene.
 pub const MAX_DIMENSIONS: usize = 32;
 
+/// What a generator knows about the render it serves, fixed for the whole render: the full
+/// layout (the camera's pair first, then the strategy's), the sample count per pixel when it
+/// is known up front (a fixed `--spp`; None under a time budget), and the image size (a
+/// single point, as the closed-form checks use, is a 1×1 image). Built once per render by the
+/// renderer; a generator reads what it needs.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Setup {
+    pub layout: Layout,
+    pub spp: Option<u64>,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Setup {
+    /// A render of `width`×`height` pixels with `strategy` (its layout after the camera's).
+    pub fn image(strategy: Layout, spp: Option<u64>, width: u32, height: u32) -> Self {
+        Setup {
+            layout: Layout::camera().then(strategy),
+            spp,
+            width,
+            height,
+        }
+    }
+
+    /// Samples at one shading point (no camera dimensions, no pixel).
+    pub fn point(strategy: Layout, spp: Option<u64>) -> Self {
+        Setup {
+            layout: strategy,
+            spp,
+            width: 1,
+            height: 1,
+        }
+    }
+}
+
 pub trait SampleGenerator: Send + Sync {
     /// The name `--sampler` takes and result tables show.
     fn name(&self) -> &'static str;
     fn describe(&self) -> &'static str;
-    /// Writes dimensions 0..out.len() of sample `key`, each in [0, 1).
-    fn fill(&self, key: SampleKey, out: &mut [f32]);
+    /// Whether the samples of a pixel are independent draws (then the per-pixel variance
+    /// across passes estimates the variance of the mean, and `predicted_rmse` applies). False
+    /// by default: a stratified or low-discrepancy generator leaves those numbers out.
+    fn independent_samples(&self) -> bool {
+        false
+    }
+    /// Whether this generator can serve `setup`; Err says why (e.g. stratification needs
+    /// `setup.spp`). The renderer calls it once, before any sample.
+    fn check(&self, _setup: &Setup) -> Result<(), String> {
+        Ok(())
+    }
+    /// Writes dimensions 0..out.len() of sample `key`, each in [0, 1); `out.len()` is at most
+    /// `setup.layout.len()`. Must depend on (setup, key) alone.
+    fn fill(&self, setup: &Setup, key: SampleKey, out: &mut [f32]);
 }
 
 /// One group of dimensions of a layout: one number, or a 2-D pair that a stratifying

@@ -6,7 +6,7 @@ use crate::prepare::{PreparedScene, SceneView};
 use crate::render::{emission_contribution, escape_contribution};
 use crate::sampling::generator::MAX_DIMENSIONS;
 use crate::sampling::stream::name_id;
-use crate::sampling::{Dims, GENERATORS, SampleKey};
+use crate::sampling::{Dims, GENERATORS, SampleGenerator, SampleKey, Setup};
 use crate::stats::Welford;
 use glam::Vec3;
 
@@ -42,11 +42,30 @@ pub fn for_each_sample(
     sp: &ShadingPoint,
     samples: u64,
     seed: u64,
+    each: impl FnMut(Vec3),
+) -> Result<(), String> {
+    for_each_sample_with(GENERATORS[0], scene, strategy, sp, samples, seed, each)
+}
+
+/// [`for_each_sample`] drawing from `generator`, told that `samples` samples will be taken
+/// (so a stratified generator stratifies them).
+pub fn for_each_sample_with(
+    generator: &dyn SampleGenerator,
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    sp: &ShadingPoint,
+    samples: u64,
+    seed: u64,
     mut each: impl FnMut(Vec3),
 ) -> Result<(), String> {
     let view = scene.view(strategy.integrand());
     let estimator = strategy.bind(view)?;
-    let dims = estimator.layout().len();
+    let setup = Setup::point(estimator.layout(), Some(samples));
+    generator.check(&setup)?;
+    let dims = setup.layout.len();
+    if dims > MAX_DIMENSIONS {
+        return Err(format!("{dims} dimensions; at most {MAX_DIMENSIONS}"));
+    }
     let id = name_id(&strategy.name());
     let mut values = [0.0f32; MAX_DIMENSIONS];
     for i in 0..samples {
@@ -56,7 +75,7 @@ pub fn for_each_sample(
             pixel: u64::MAX,
             index: i,
         };
-        GENERATORS[0].fill(key, &mut values[..dims]);
+        generator.fill(&setup, key, &mut values[..dims]);
         let probes = estimator.sample(sp, &mut Dims::new(&values[..dims]));
         each(probe_radiance(
             scene,
@@ -78,8 +97,22 @@ pub fn estimate_at(
     samples: u64,
     seed: u64,
 ) -> [Welford; 3] {
+    estimate_at_with(GENERATORS[0], scene, strategy, sp, samples, seed)
+}
+
+/// [`estimate_at`] drawing from `generator`. For a generator whose samples are not
+/// independent the Welford variance is not the variance of the mean: use replicates with
+/// different seeds (`closed_form::PointCase::check_with` does).
+pub fn estimate_at_with(
+    generator: &dyn SampleGenerator,
+    scene: &PreparedScene,
+    strategy: &dyn Strategy,
+    sp: &ShadingPoint,
+    samples: u64,
+    seed: u64,
+) -> [Welford; 3] {
     let mut stats = [Welford::default(); 3];
-    for_each_sample(scene, strategy, sp, samples, seed, |l| {
+    for_each_sample_with(generator, scene, strategy, sp, samples, seed, |l| {
         for (c, s) in stats.iter_mut().enumerate() {
             s.add(l[c] as f64);
         }

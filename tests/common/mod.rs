@@ -287,35 +287,56 @@ pub fn check_run_dir(dir: &Path, settled: bool) -> Result<serde_json::Value, Str
             )
         })
         .collect();
+    // Their samplers, pair by pair (absent before the sampler axis: independent).
+    let samplers: Vec<String> = (0..completed.len())
+        .map(|k| {
+            meta["completed_samplers"][k]
+                .as_str()
+                .unwrap_or("independent")
+                .to_string()
+        })
+        .collect();
     let mut finals = Vec::new();
     if dir.join("results.csv").exists() {
         let mut reader = csv::Reader::from_path(dir.join("results.csv"))
             .map_err(|e| format!("{shown}/results.csv: {e}"))?;
         for r in reader.records() {
             let r = r.map_err(|e| format!("{shown}/results.csv: {e}"))?;
-            if r.len() != 12 {
+            if r.len() != 13 {
                 return Err(format!("{shown}/results.csv: a row of {} fields", r.len()));
             }
             if &r[7] == "7" {
-                finals.push((r[1].to_string(), r[5].parse::<u64>().unwrap_or(u64::MAX)));
+                finals.push((
+                    r[1].to_string(),
+                    r[5].parse::<u64>().unwrap_or(u64::MAX),
+                    r[12].to_string(),
+                ));
             }
         }
     }
-    for (s, run) in &completed {
-        if !finals.contains(&(s.clone(), *run)) {
+    for ((s, run), g) in completed.iter().zip(&samplers) {
+        if !finals.contains(&(s.clone(), *run, g.clone())) {
             return Err(format!(
-                "{shown}: `{s}` run {run} is completed but has no final row"
+                "{shown}: `{s}` ({g}) run {run} is completed but has no final row"
             ));
         }
         if *run == 0 {
-            for suffix in ["", ".variance"] {
-                let exr = dir.join(format!("{s}{suffix}.exr"));
+            let stem = dibench::harness::compare::image_stem(s, g);
+            // A non-independent sampler writes no variance image (docs/samplers.md).
+            let suffixes: &[&str] = if g == "independent" {
+                &["", ".variance"]
+            } else {
+                &[""]
+            };
+            for suffix in suffixes {
+                let exr = dir.join(format!("{stem}{suffix}.exr"));
                 dibench::output::read_exr(&exr).map_err(|e| e.to_string())?;
             }
         }
     }
     if status == "complete" {
-        let strategies = meta["strategies"].as_array().map_or(0, |a| a.len()) as u64;
+        let samplers = meta["samplers"].as_array().map_or(1, |a| a.len()) as u64;
+        let strategies = meta["strategies"].as_array().map_or(0, |a| a.len()) as u64 * samplers;
         let runs = meta["runs"].as_u64().unwrap_or(0);
         if completed.len() as u64 != strategies * runs {
             return Err(format!(

@@ -1,0 +1,282 @@
+//! The building blocks the low-discrepancy generators share: the first two dimensions of the
+//! Sobol sequence, a hashed nested-uniform (Owen) scramble in base 2, and 2-D Morton codes.
+//!
+//! Only Sobol dimensions 0 and 1 are needed: every `Dimension::pair` of a layout gets its own
+//! randomized copy of this (0,2)-sequence and every single dimension its own scrambled van der
+//! Corput sequence ("padding", Burley 2020 §4, as pbrt-v4's padded and Z-Sobol samplers do).
+//! Within one pair the two coordinates share the index, so every aligned block of 2^m points
+//! of the pair is a (0,m,2)-net in base 2; across groups the index is shuffled with a different
+//! seed, so no two groups are correlated.
+
+use crate::math::mix64;
+
+/// Sobol dimension 0 of point `i`, as a 32-bit binary fraction: the van der Corput sequence.
+pub fn sobol_0(i: u32) -> u32 {
+    i.reverse_bits()
+}
+
+/// Sobol dimension 1 of point `i`, as a 32-bit binary fraction. Its generator matrix is the
+/// Pascal matrix mod 2: column k is v_k with v_0 = 1/2 and v_{k+1} = v_k ⊕ (v_k >> 1). The map
+/// is linear over GF(2), so it is four lookups, one per byte of `i`, in tables built at compile
+/// time (4 KiB) — no data-dependent branch per bit.
+pub fn sobol_1(i: u32) -> u32 {
+    let t = &SOBOL_1_BYTES;
+    t[0][(i & 0xff) as usize]
+        ^ t[1][((i >> 8) & 0xff) as usize]
+        ^ t[2][((i >> 16) & 0xff) as usize]
+        ^ t[3][(i >> 24) as usize]
+}
+
+/// The generator matrix's 32 columns.
+const fn sobol_1_columns() -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut c = 1u32 << 31;
+    let mut k = 0;
+    while k < 32 {
+        v[k] = c;
+        c ^= c >> 1;
+        k += 1;
+    }
+    v
+}
+
+static SOBOL_1_BYTES: [[u32; 256]; 4] = sobol_1_tables();
+
+const fn sobol_1_tables() -> [[u32; 256]; 4] {
+    let v = sobol_1_columns();
+    let mut t = [[0u32; 256]; 4];
+    let mut byte = 0;
+    while byte < 4 {
+        let mut b = 0;
+        while b < 256 {
+            let mut x = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if b & (1 << bit) != 0 {
+                    x ^= v[byte * 8 + bit];
+                }
+                bit += 1;
+            }
+            t[byte][b] = x;
+            b += 1;
+        }
+        byte += 1;
+    }
+    t
+}
+
+/// [`sobol_1`] bit by bit, the definition the tables are checked against.
+pub fn sobol_1_reference(mut i: u32) -> u32 {
+    let mut v = 1u32 << 31;
+    let mut x = 0;
+    while i != 0 {
+        if i & 1 != 0 {
+            x ^= v;
+        }
+        i >>= 1;
+        v ^= v >> 1;
+    }
+    x
+}
+
+/// A bijection of 32-bit words in which output bit p is input bit p flipped by a function of
+/// the input bits below p (and of `seed`): each step is such a map — adding a constant (the
+/// carry comes from below), xor with the word times an even constant (its bit p depends on
+/// bits below p), multiplying by an odd constant — and so is their composition. Applied to a
+/// bit-reversed fraction it is a nested uniform scramble: digit k is flipped by a hash of the
+/// digits before it (Laine & Karras 2011; Burley 2020). Four 32-bit words of a hash of the
+/// seed enter as additive and multiplicative constants.
+fn lower_triangular_hash(mut x: u32, seed: u64) -> u32 {
+    // One 64-bit hash of the seed gives the four constants (the second pair by a multiply,
+    // which keeps them well mixed at the cost of one instruction instead of another hash).
+    let s = mix64(seed);
+    let t = s.wrapping_mul(0xD1B5_4A32_D192_ED03);
+    let (a, b, c, d) = (
+        s as u32,
+        (s >> 32) as u32,
+        (t >> 32) as u32,
+        t as u32 ^ (s >> 17) as u32,
+    );
+    x = x.wrapping_add(a);
+    x ^= x.wrapping_mul(0x6d2b_79f4);
+    x = x.wrapping_mul(b | 1);
+    x ^= x.wrapping_mul(c & !1);
+    x = x.wrapping_add(d);
+    x ^= x.wrapping_mul(0xa3b1_95c8);
+    x ^= x.wrapping_mul(0x3c6e_f372 & !1);
+    x
+}
+
+/// Owen scramble of the 32-bit binary fraction `x` with `seed`: the binary digit at depth k
+/// (from the most significant) is flipped by a hash of the k − 1 digits above it and the
+/// seed. Applied to a sample index it is a shuffle that maps every aligned block of 2^m
+/// indices onto an aligned block of 2^m indices (the bits from m up depend only on bits from
+/// m up), so a prefix of 2^m points of a (0,2)-sequence stays a (0,m,2)-net.
+pub fn owen(x: u32, seed: u64) -> u32 {
+    lower_triangular_hash(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// A 32-bit fraction as an f32 in [0, 1): its top 24 bits, exactly representable.
+pub fn to_unit(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// One randomized point of a (0,2)-sequence pair, as used by every layout group: the index `i`
+/// Owen-shuffled with `seed`, then Sobol dimensions 0 and 1 of it, each Owen-scrambled with its
+/// own seed derived from `seed`. Equal to
+/// `[owen(sobol_0(j), seed ^ A), owen(sobol_1(j), seed ^ B)]` with `j = owen(i, seed)`, with
+/// the bit reversals that cancel left out (owen ∘ sobol_0 = reverse ∘ hash, since sobol_0 is
+/// itself a reversal). `pair` false: only the first coordinate.
+pub fn scrambled_pair(i: u32, seed: u64, pair: bool) -> [f32; 2] {
+    scrambled_point(owen(i, seed), seed, pair)
+}
+
+/// Sobol point `j` (dimensions 0 and 1, or 0 alone), each coordinate Owen-scrambled with a seed
+/// derived from `seed`; no index shuffle (Z-Sobol permutes its index itself).
+pub fn scrambled_point(j: u32, seed: u64, pair: bool) -> [f32; 2] {
+    let x = lower_triangular_hash(j, seed ^ 0xa5a5_0001).reverse_bits();
+    let y = if pair {
+        owen(sobol_1(j), seed ^ 0xa5a5_0002)
+    } else {
+        0
+    };
+    [to_unit(x), to_unit(y)]
+}
+
+/// Interleaves the bits of x (even positions) and y (odd positions).
+pub fn morton_2d(x: u32, y: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64;
+        v = (v | (v << 16)) & 0x0000_ffff_0000_ffff;
+        v = (v | (v << 8)) & 0x00ff_00ff_00ff_00ff;
+        v = (v | (v << 4)) & 0x0f0f_0f0f_0f0f_0f0f;
+        v = (v | (v << 2)) & 0x3333_3333_3333_3333;
+        v = (v | (v << 1)) & 0x5555_5555_5555_5555;
+        v
+    }
+    spread(x) | (spread(y) << 1)
+}
+
+/// ⌈log2 n⌉ for n ≥ 1 (0 for n ≤ 1).
+pub fn ceil_log2(n: u64) -> u32 {
+    if n <= 1 {
+        0
+    } else {
+        64 - (n - 1).leading_zeros()
+    }
+}
+
+/// Whether `points` (2-D, as 32-bit fractions) form a (0,m,2)-net in base 2, 2^m of them:
+/// for every split m = a + b, each of the 2^m elementary intervals of size 2^-a × 2^-b
+/// holds exactly one point. For the tests and the dimension-pair checks.
+pub fn is_02_net(points: &[[u32; 2]]) -> bool {
+    let n = points.len();
+    if !n.is_power_of_two() {
+        return false;
+    }
+    let m = n.trailing_zeros();
+    for a in 0..=m {
+        let b = m - a;
+        let mut seen = vec![false; n];
+        for p in points {
+            let ix = if a == 0 {
+                0
+            } else {
+                (p[0] >> (32 - a)) as usize
+            };
+            let iy = if b == 0 {
+                0
+            } else {
+                (p[1] >> (32 - b)) as usize
+            };
+            let cell = (ix << b) | iy;
+            if std::mem::replace(&mut seen[cell], true) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_and_shortcuts_match_their_definitions() {
+        let mut x = 0x1234_5678u32;
+        for i in (0..5000u32).chain([u32::MAX, 1 << 31, 0xdead_beef]) {
+            assert_eq!(sobol_1(i), sobol_1_reference(i), "{i}");
+            x = x.wrapping_mul(747796405).wrapping_add(2891336453);
+            for (i, seed) in [(i, 9u64), (x, x as u64)] {
+                let j = owen(i, seed);
+                let [a, b] = scrambled_pair(i, seed, true);
+                assert_eq!(a, to_unit(owen(sobol_0(j), seed ^ 0xa5a5_0001)));
+                assert_eq!(b, to_unit(owen(sobol_1(j), seed ^ 0xa5a5_0002)));
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_first_points() {
+        let half = 1u32 << 31;
+        let d1: Vec<u32> = (0..4).map(sobol_1).collect();
+        assert_eq!(d1, [0, half, half + (half >> 1), half >> 1]);
+        assert_eq!(sobol_0(1), half);
+        assert_eq!(sobol_0(2), half >> 1);
+    }
+
+    /// Every aligned block of 2^m points of (dim 0, dim 1) is a (0,m,2)-net, unscrambled and
+    /// scrambled; the negative control: dims (0, 0) — a pair that reused one dimension — is not.
+    #[test]
+    fn sobol_pairs_are_02_nets() {
+        for m in 1..=8u32 {
+            let n = 1u32 << m;
+            for block in [0u32, 1, 5] {
+                let pts: Vec<[u32; 2]> = (block * n..(block + 1) * n)
+                    .map(|i| [sobol_0(i), sobol_1(i)])
+                    .collect();
+                assert!(is_02_net(&pts), "m {m} block {block}");
+            }
+            for seed in 0..20u64 {
+                let pts: Vec<[u32; 2]> = (0..n)
+                    .map(|i| {
+                        let j = owen(i, seed);
+                        [owen(sobol_0(j), seed ^ 1), owen(sobol_1(j), seed ^ 2)]
+                    })
+                    .collect();
+                assert!(is_02_net(&pts), "scrambled m {m} seed {seed}");
+            }
+            let reused: Vec<[u32; 2]> = (0..n).map(|i| [sobol_0(i), sobol_0(i)]).collect();
+            assert!(
+                m == 1 || !is_02_net(&reused),
+                "m {m}: the net test cannot see a reused dimension"
+            );
+        }
+    }
+
+    /// The index shuffle maps aligned blocks onto aligned blocks (a bijection there).
+    #[test]
+    fn owen_index_shuffle_keeps_blocks() {
+        for seed in 0..10u64 {
+            for m in [1u32, 4, 7] {
+                let mut got: Vec<u32> = (0..1u32 << m).map(|i| owen(i, seed)).collect();
+                let hi = got[0] >> m;
+                assert!(got.iter().all(|j| j >> m == hi));
+                got.sort_unstable();
+                got.dedup();
+                assert_eq!(got.len(), 1 << m);
+            }
+        }
+    }
+
+    #[test]
+    fn morton_and_log2() {
+        assert_eq!(morton_2d(0b11, 0b01), 0b0111);
+        assert_eq!(morton_2d(0, 1), 2);
+        assert_eq!(
+            (ceil_log2(1), ceil_log2(2), ceil_log2(3), ceil_log2(256)),
+            (0, 1, 2, 8)
+        );
+    }
+}
