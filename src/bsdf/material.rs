@@ -57,21 +57,11 @@ pub fn parse(
         ));
     };
     let bsdf = (t.parse)(&mut params)?;
-    if let Some(key) = params.leftover() {
-        let key = key.to_string();
-        return Err(params.error(
-            &key,
-            format!(
-                "unknown field for a `{}` material (its fields: {}{})",
-                t.name,
-                t.fields.join(", "),
-                if kind.is_none() {
-                    "; a `type` field selects another kind"
-                } else {
-                    ""
-                }
-            ),
-        ));
-    }
+    let hint = if kind.is_none() {
+        "; a `type` field selects another kind"
+    } else {
+        ""
+    };
+    params.reject_leftover(&format!("a `{}` material", t.name), t.fields, hint)?;
     Ok((t, bsdf))
 }

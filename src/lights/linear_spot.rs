@@ -5,10 +5,8 @@
 //! type added in one file (docs/extending.md (e)): it reuses the point shape's delta sampling.
 
 use super::bounds::{Bounds, LightBounds};
-use super::{
-    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, LightSpec, LightType,
-    direction_to,
-};
+use super::point::PointLight;
+use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, LightSpec, LightType};
 use crate::math::luminance;
 use glam::Vec3;
 use std::sync::Arc;
@@ -21,23 +19,42 @@ pub static LINEAR_SPOT: LightType = LightType {
     fields: super::spot::SPOT.fields,
     parse: |p| {
         let (cone, start) = super::spot::parse_cone(p)?;
-        let light = LinearSpotLight {
-            position: Vec3::ZERO,
-            axis: Vec3::Z,
-            intensity: Vec3::ZERO,
-            theta_cone: cone.to_radians(),
-            theta_start: start.to_radians(),
-        };
-        let intensity = super::point::power_or_intensity(p, light.solid_angle() as f32)?;
+        let (theta_cone, theta_start) = (cone.to_radians(), start.to_radians());
+        let solid = solid_angle(theta_start, theta_cone) as f32;
+        let intensity = super::point::power_or_intensity(p, solid)?;
         Ok(Arc::new(LinearSpotLight {
             position: p.required_rgb("position")?,
             axis: p.direction("direction")?,
             intensity,
-            ..light
+            theta_cone,
+            theta_start,
         }))
     },
     chi2_cases: crate::chi2::no_cases,
 };
+
+/// Φ/I₀ = 2π [∫₀^θs sin θ dθ + ∫_θs^θe (θe − θ)/(θe − θs) sin θ dθ], in f64, each part
+/// in a form without cancellation: 1 − cos θs = 2 sin²(θs/2), and with Δ = θe − θs the
+/// band's integral is [cos θs (Δ − sin Δ) + sin θs (1 − cos Δ)] / Δ (zero for Δ = 0).
+pub fn solid_angle(theta_start: f32, theta_cone: f32) -> f64 {
+    let (s, e) = (theta_start as f64, theta_cone as f64);
+    let core = 2.0 * (0.5 * s).sin().powi(2);
+    let delta = e - s;
+    let band = if delta > 0.0 {
+        // Δ − sin Δ by its series where the difference would cancel.
+        let d_minus_sin = if delta < 1e-2 {
+            let d2 = delta * delta;
+            delta * d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0))
+        } else {
+            delta - delta.sin()
+        };
+        (s.cos() * d_minus_sin + s.sin() * 2.0 * (0.5 * delta).sin().powi(2)) / delta
+    } else {
+        0.0
+    };
+    2.0 * std::f64::consts::PI * (core + band)
+}
+
 
 #[derive(Clone, Copy, Debug)]
 pub struct LinearSpotLight {
@@ -70,43 +87,24 @@ impl LinearSpotLight {
         a.cross(b).length().atan2(a.dot(b))
     }
 
-    /// Φ/I₀ = 2π [∫₀^θs sin θ dθ + ∫_θs^θe (θe − θ)/(θe − θs) sin θ dθ], in f64, each part
-    /// in a form without cancellation: 1 − cos θs = 2 sin²(θs/2), and with Δ = θe − θs the
-    /// band's integral is [cos θs (Δ − sin Δ) + sin θs (1 − cos Δ)] / Δ (zero for Δ = 0).
+    /// Φ/I₀ of this light ([`solid_angle`]).
     pub fn solid_angle(&self) -> f64 {
-        let (s, e) = (self.theta_start as f64, self.theta_cone as f64);
-        let core = 2.0 * (0.5 * s).sin().powi(2);
-        let delta = e - s;
-        let band = if delta > 0.0 {
-            // Δ − sin Δ by its series where the difference would cancel.
-            let d_minus_sin = if delta < 1e-2 {
-                let d2 = delta * delta;
-                delta * d2 / 6.0 * (1.0 - d2 / 20.0 * (1.0 - d2 / 42.0))
-            } else {
-                delta - delta.sin()
-            };
-            (s.cos() * d_minus_sin + s.sin() * 2.0 * (0.5 * delta).sin().powi(2)) / delta
-        } else {
-            0.0
-        };
-        2.0 * std::f64::consts::PI * (core + band)
+        solid_angle(self.theta_start, self.theta_cone)
     }
 
+    /// The point light's sample, scaled by the falloff at its direction.
     pub fn sample_from(&self, p: Vec3) -> Option<LightSample> {
-        let (wi, d2) = direction_to(p, self.position)?;
-        let falloff = self.falloff(Self::angle(-wi, self.axis));
+        let point = PointLight {
+            position: self.position,
+            intensity: self.intensity,
+        };
+        let mut s = point.sample_from(p)?;
+        let falloff = self.falloff(Self::angle(-s.wi, self.axis));
         if falloff == 0.0 {
             return None;
         }
-        Some(LightSample {
-            wi,
-            point: self.position,
-            normal: Vec3::ZERO,
-            point_error: Vec3::ZERO,
-            radiance: self.intensity * (falloff / d2),
-            pdf: 1.0,
-            distant: false,
-        })
+        s.radiance *= falloff;
+        Some(s)
     }
 }
 

@@ -179,17 +179,7 @@ fn parse_lights(path: &Path, mut tables: toml::Table) -> Result<Vec<SceneLight>>
             };
             let mut params = Params::new(path, kind.name, i, table);
             let spec = (kind.parse)(&mut params)?;
-            if let Some(key) = params.leftover() {
-                let key = key.to_string();
-                return Err(params.error(
-                    &key,
-                    format!(
-                        "unknown field for a `{}` (its fields: {})",
-                        kind.name,
-                        kind.fields.join(", ")
-                    ),
-                ));
-            }
+            params.reject_leftover(&format!("a `{}`", kind.name), kind.fields, "")?;
             lights.push(SceneLight {
                 kind,
                 field: params.field(""),

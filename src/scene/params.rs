@@ -36,9 +36,19 @@ impl<'a> Params<'a> {
         }
     }
 
-    /// The first field no reader took, if any.
-    pub fn leftover(&self) -> Option<&str> {
-        self.table.keys().next().map(String::as_str)
+    /// An error naming the first field no reader took, if any: `what` names the table's kind
+    /// (`a \`ggx\` material`), `fields` those it reads, `hint` is appended to the message.
+    pub fn reject_leftover(&self, what: &str, fields: &[&str], hint: &str) -> Result<()> {
+        match self.table.keys().next() {
+            None => Ok(()),
+            Some(key) => Err(self.error(
+                key,
+                format!(
+                    "unknown field for {what} (its fields: {}{hint})",
+                    fields.join(", ")
+                ),
+            )),
+        }
     }
 
     pub fn error(&self, key: &str, message: impl Into<String>) -> Error {
