@@ -54,7 +54,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             )?);
         }
         let opts = compare::CompareOptions {
-            time_s,
+            budget: compare::Budget::Time(time_s),
             seed: 1,
             threads,
             runs,

@@ -97,7 +97,7 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
          rmse_ci95,rmse_debiased,mse_debiased_mean,mse_debiased_ci95,relmse_mean,relmse_ci95,\
          relmse_debiased_mean,relmse_debiased_ci95,efficiency,predicted_rmse,\
          reference_noise_floor,slope_time_mean,slope_time_ci95,slope_spp_mean,welch_p_vs_best,\
-         holm_p_vs_best,vs_best,sampler"
+         holm_p_vs_best,vs_best,sampler,budget_spp"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{summary}");
@@ -672,6 +672,107 @@ fn compare_with_two_samplers() {
     assert_ne!(code, 0);
     assert!(
         stderr.contains("--sampler stratified") && stderr.contains("--spp"),
+        "{stderr}"
+    );
+}
+
+/// `compare --spp 16`: every strategy × sampler renders exactly 16 passes, checkpoints at
+/// ⌈16 / 2^(7−k)⌉ passes (1, 2, 4, 8, 16: the first four coincide), the stratified generator is
+/// accepted, summary.csv has the sample budget and no time budget or overshoot, and the
+/// console says "16 spp per strategy". `--spp` with `--time` is a usage error naming both.
+#[test]
+fn compare_at_equal_spp() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), SCENE).unwrap();
+    let (code, stdout, stderr) = dibench(
+        &[
+            "compare",
+            "tiny.toml",
+            "--spp",
+            "16",
+            "--runs",
+            "2",
+            "--reference-spp",
+            "64",
+            "--strategies",
+            "light,cosine",
+            "--threads",
+            "1",
+            "--sampler",
+            "independent,stratified,zsobol",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("16 spp per strategy"), "{stdout}");
+    assert!(!stdout.contains("deviation from the budget"), "{stdout}");
+    let run_dir = &run_dirs(&dir.path().join("out/tiny"))[0];
+    let results = std::fs::read_to_string(run_dir.join("results.csv")).unwrap();
+    let mut lines = results.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // 2 strategies × 3 samplers × 2 runs, five checkpoint rows each.
+    assert_eq!(rows.len(), 2 * 3 * 2 * 5, "{results}");
+    for r in &rows {
+        let expected = match r[col("checkpoint")] {
+            "0" => "1",
+            "4" => "2",
+            "5" => "4",
+            "6" => "8",
+            "7" => "16",
+            other => panic!("checkpoint {other}: {results}"),
+        };
+        assert_eq!(r[col("spp")], expected, "{results}");
+    }
+    for g in ["independent", "stratified", "zsobol"] {
+        assert!(
+            rows.iter().any(|r| r[col("sampler")] == g),
+            "no {g}: {results}"
+        );
+    }
+    let summary = std::fs::read_to_string(run_dir.join("summary.csv")).unwrap();
+    let mut lines = summary.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 6, "{summary}");
+    for r in &rows {
+        assert_eq!(r[col("budget_spp")], "16", "{summary}");
+        assert_eq!(r[col("budget_s")], "", "{summary}");
+        assert_eq!(r[col("overshoot_max")], "", "{summary}");
+        assert_eq!(r[col("spp_mean")], "16.0", "{summary}");
+        let predicted = r[col("predicted_rmse")];
+        if r[col("sampler")] == "independent" {
+            assert!(predicted.parse::<f64>().unwrap() > 0.0, "{summary}");
+        } else {
+            assert_eq!(predicted, "", "a non-independent row predicted: {summary}");
+        }
+    }
+    let meta = std::fs::read_to_string(run_dir.join("run.json")).unwrap();
+    assert!(
+        meta.contains("\"budget_spp\": 16") && !meta.contains("budget_s\""),
+        "{meta}"
+    );
+
+    let (code, _, stderr) = dibench(
+        &[
+            "compare",
+            "tiny.toml",
+            "--spp",
+            "16",
+            "--time",
+            "1",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("--spp") && stderr.contains("--time"),
         "{stderr}"
     );
 }

@@ -1,4 +1,5 @@
-//! `dibench compare`: every applicable strategy at equal time.
+//! `dibench compare`: every applicable strategy at equal time (or, with `--spp`, at equal
+//! sample count).
 
 use super::{Common, check_image_memory, image_memory, load_with, parse_seconds, pool};
 use crate::error::{Error, Result};
@@ -14,6 +15,11 @@ pub struct CompareArgs {
     /// Wall-clock budget per strategy, in seconds.
     #[arg(long, default_value_t = 2.0, value_parser = parse_seconds, allow_hyphen_values = true)]
     pub time: f64,
+    /// Samples per pixel per strategy instead of a time budget: every strategy renders exactly
+    /// this many passes (what `--sampler stratified` needs; a power of two keeps a Sobol
+    /// prefix a (0,2)-net).
+    #[arg(long, conflicts_with = "time", value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
+    pub spp: Option<u64>,
     /// Samples per pixel of the reference, fixed; by default a pilot of every strategy sizes
     /// the reference by its noise floor instead (`--reference-floor`).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..), allow_negative_numbers = true)]
@@ -34,8 +40,8 @@ pub struct CompareArgs {
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..), allow_negative_numbers = true)]
     pub runs: u32,
     /// Comma-separated sample generators; every strategy runs with each
-    /// (independent, stratified, sobol, zsobol; stratified needs a fixed sample count, which
-    /// an equal-time run does not have, and is refused). References stay independent.
+    /// (independent, stratified, sobol, zsobol; stratified needs the sample count up front,
+    /// so it needs `--spp`). References stay independent.
     #[arg(long, value_delimiter = ',', default_value = "independent")]
     pub sampler: Vec<String>,
     /// Run the pilots only and print each reference's plan (its strategy, target floor,
@@ -45,11 +51,21 @@ pub struct CompareArgs {
     pub plan: bool,
 }
 
+impl CompareArgs {
+    /// `--spp N` if given, else `--time`.
+    pub fn budget(&self) -> compare::Budget {
+        match self.spp {
+            Some(n) => compare::Budget::Spp(n),
+            None => compare::Budget::Time(self.time),
+        }
+    }
+}
+
 pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
     // --time and --runs are bounded by their parsers; their seeds together, here, before
     // anything is loaded.
     options::check_seeds(a.common.seed, a.runs)?;
-    let samplers = compare::resolve_samplers(&a.sampler)?.len() as u64;
+    let samplers = compare::resolve_samplers(&a.sampler, a.budget())?.len() as u64;
     let (pool, threads) = pool(a.common.threads)?;
     let (scene, isa) = load_with(&a.common)?;
     scene.scene.require_light_power()?;
@@ -151,7 +167,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         }
         let references = compare::References { images };
         let opts = compare::CompareOptions {
-            time_s: a.time,
+            budget: a.budget(),
             seed: a.common.seed,
             threads,
             runs: a.runs,
@@ -194,7 +210,7 @@ fn pilot_plans(
             "compare stopped during the pilot".into(),
         ));
     }
-    Ok(pilot::plan(&pilots, a.time, a.reference_floor))
+    Ok(pilot::plan(&pilots, a.budget(), a.reference_floor))
 }
 
 /// `compare --plan`: one line per integrand. The floor falls as 1/√N and N grows with time,

@@ -1,9 +1,11 @@
-//! Equal-time comparison: every applicable strategy renders for the same wall-clock budget;
-//! the error against the reference is recorded at log-spaced checkpoints, so one run gives the
-//! error-against-time curve (RMSE ∝ 1/√t for an unbiased estimator). With `runs` > 1 every
+//! Equal-time comparison: every applicable strategy renders for the same wall-clock budget
+//! (or, with `--spp`, the same number of samples per pixel); the error against the reference
+//! is recorded at log-spaced checkpoints, so one run gives the error-against-time curve
+//! (RMSE ∝ 1/√t for an unbiased estimator with independent samples). With `runs` > 1 every
 //! strategy is run that many times with independent seeds, so that the error of each is
 //! known with a confidence interval (Celarek et al. 2019); see `summary`.
 
+pub use super::options::Budget;
 use super::summary::{FinalRun, SummaryRow, summarize};
 use super::{COMMIT, RUSTC, VERSION, cpu_model, progress_bar};
 use crate::error::{Error, Result};
@@ -21,12 +23,13 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-/// Checkpoints at T/2^(K-1), ..., T/2, T.
+/// Checkpoints at T/2^(K-1), ..., T/2, T (or N/2^(K-1), ..., N passes, rounded up).
 pub const CHECKPOINTS: u32 = 8;
 
 #[derive(Clone, Debug)]
 pub struct CompareOptions {
-    pub time_s: f64,
+    /// Equal time (`--time`) or equal samples per pixel (`--spp`).
+    pub budget: Budget,
     /// Seed of run 0; run k uses `seed + k`.
     pub seed: u64,
     pub threads: usize,
@@ -43,7 +46,7 @@ impl CompareOptions {
     /// The bounds `compare::run` needs (`harness::options`; the command line checks the same
     /// ones as it parses).
     pub fn check(&self) -> Result<()> {
-        super::options::check_seconds("--time", self.time_s)?;
+        self.budget.check()?;
         super::options::check_at_least_one("--runs", self.runs as u64)?;
         super::options::check_seeds(self.seed, self.runs)?;
         self.generators().map(|_| ())
@@ -51,14 +54,17 @@ impl CompareOptions {
 
     /// The generators of `samplers` ([`resolve_samplers`]).
     pub fn generators(&self) -> Result<Vec<&'static dyn SampleGenerator>> {
-        resolve_samplers(&self.samplers)
+        resolve_samplers(&self.samplers, self.budget)
     }
 }
 
-/// The generators named (the default one when `names` is empty), each checked against an
-/// equal-time budget: it does not know the sample count, which stratification needs. A
+/// The generators named (the default one when `names` is empty), each checked against the
+/// budget: an equal-time one does not know the sample count, which stratification needs. A
 /// usage error names `--sampler` and lists the generators.
-pub fn resolve_samplers(names: &[String]) -> Result<Vec<&'static dyn SampleGenerator>> {
+pub fn resolve_samplers(
+    names: &[String],
+    budget: Budget,
+) -> Result<Vec<&'static dyn SampleGenerator>> {
     if names.is_empty() {
         return Ok(vec![crate::sampling::GENERATORS[0]]);
     }
@@ -71,14 +77,17 @@ pub fn resolve_samplers(names: &[String]) -> Result<Vec<&'static dyn SampleGener
             ))
         })?;
         // Under a time budget the sample count per pixel is not known up front.
-        let probe = Setup::image(crate::sampling::Layout::default(), None, 1, 1);
+        let probe = Setup::image(crate::sampling::Layout::default(), budget.spp(), 1, 1);
         if let Err(why) = g.check(&probe) {
-            return Err(Error::Usage(format!(
-                "--sampler {}: {why}; `compare` runs at equal time (--time), where it is not \
-                 known, so leave `{}` out of --sampler",
-                g.name(),
-                g.name()
-            )));
+            return Err(Error::Usage(match budget {
+                Budget::Time(_) => format!(
+                    "--sampler {}: {why}; `compare` runs at equal time (--time) unless given \
+                     --spp N, so give --spp or leave `{}` out of --sampler",
+                    g.name(),
+                    g.name()
+                ),
+                Budget::Spp(n) => format!("--sampler {} with --spp {n}: {why}", g.name()),
+            }));
         }
         if !out.iter().any(|o| o.name() == g.name()) {
             out.push(g);
@@ -139,7 +148,11 @@ struct RunMeta<'a> {
     cpu_model: String,
     runs: u32,
     seeds: Vec<u64>,
-    budget_s: f64,
+    /// One of the two: seconds (`--time`) or samples per pixel (`--spp`) per strategy run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    budget_s: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    budget_spp: Option<u64>,
     strategies: Vec<String>,
     samplers: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -172,15 +185,15 @@ pub struct StrategyRun {
     pub interrupted: bool,
 }
 
-/// One strategy's equal-time run with seed `seed`: passes while the next one is predicted to
-/// end within the budget, rows at checkpoints. Time spent measuring the error is excluded
-/// from the clock.
+/// One strategy's run with seed `seed`: passes until the budget is spent, rows at
+/// checkpoints. Time spent measuring the error is excluded from the clock.
 ///
 /// Budget bound: a pass is the unit of work (a partial pass would leave some pixels with one
-/// sample fewer and bias the mean), so the loop predicts the next pass's duration as the
-/// mean pass time so far and starts it only if it is predicted to end within the budget. The
-/// final time lies within about one pass of the budget, on either side; the measured
-/// deviation is reported (`time_s` of the last row, `overshoot` in summary.csv).
+/// sample fewer and bias the mean). At equal time the loop predicts the next pass's duration
+/// as the mean pass time so far and starts it only if it is predicted to end within the
+/// budget: the final time lies within about one pass of the budget, on either side, and the
+/// measured deviation is reported (`time_s` of the last row, `overshoot` in summary.csv). At
+/// equal spp it renders exactly N passes; checkpoint k is at ⌈N / 2^(K−1−k)⌉ passes.
 pub fn run_strategy(
     scene: &PreparedScene,
     strategy: &dyn Strategy,
@@ -188,17 +201,23 @@ pub fn run_strategy(
     reference: &Image,
     opts: &CompareOptions,
     run: u32,
-    mut on_progress: impl FnMut(Duration),
+    mut on_progress: impl FnMut(Duration, u64),
 ) -> Result<StrategyRun> {
     let seed = opts.seed.wrapping_add(run as u64);
-    let mut renderer = Renderer::with_generator(scene, strategy, seed, generator)?;
+    let mut renderer = Renderer::with_sampler(scene, strategy, seed, generator, opts.budget.spp())?;
     let name = strategy.name();
     let sampler = generator.name().to_string();
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     // Validated where the options are built (`--time`); saturating for other callers.
-    let budget = Duration::try_from_secs_f64(opts.time_s).unwrap_or(Duration::MAX);
     let _polling = crate::interrupt::polling();
-    let checkpoint_at = |k: u32| budget.div_f64(2f64.powi((CHECKPOINTS - 1 - k) as i32));
+    let scale = |k: u32| 2f64.powi((CHECKPOINTS - 1 - k) as i32);
+    // Whether checkpoint k has been reached after `spp` passes taking `elapsed`.
+    let reached = |k: u32, spp: u64, elapsed: Duration| match opts.budget {
+        Budget::Time(t) => {
+            elapsed >= Duration::try_from_secs_f64(t / scale(k)).unwrap_or(Duration::MAX)
+        }
+        Budget::Spp(n) => spp as f64 >= (n as f64 / scale(k)).ceil(),
+    };
     let mut rows = Vec::new();
     let mut next = 0u32;
     let mut elapsed = Duration::ZERO;
@@ -226,20 +245,23 @@ pub fn run_strategy(
             interrupted = true;
             break;
         }
-        if film.spp > 0 {
-            let mean_pass = elapsed.div_f64(film.spp as f64);
-            if elapsed + mean_pass > budget {
-                break;
+        let done = match opts.budget {
+            Budget::Time(t) => {
+                film.spp > 0 && (elapsed + elapsed.div_f64(film.spp as f64)).as_secs_f64() > t
             }
+            Budget::Spp(n) => film.spp >= n,
+        };
+        if done {
+            break;
         }
         let start = Instant::now();
         renderer.add_pass(&mut film);
         elapsed += start.elapsed();
-        on_progress(elapsed);
-        if next < CHECKPOINTS - 1 && elapsed >= checkpoint_at(next) {
+        on_progress(elapsed, film.spp);
+        if next < CHECKPOINTS - 1 && reached(next, film.spp, elapsed) {
             rows.push(row(&film, next, elapsed));
             // One pass may cover several checkpoints; the next row is for the next one ahead.
-            while next < CHECKPOINTS - 1 && elapsed >= checkpoint_at(next) {
+            while next < CHECKPOINTS - 1 && reached(next, film.spp, elapsed) {
                 next += 1;
             }
         }
@@ -267,7 +289,7 @@ pub struct CompareReport {
     pub backend: String,
     pub threads: usize,
     pub seed: u64,
-    pub time_s: f64,
+    pub budget: Budget,
     pub references: Vec<ReferenceUsed>,
     /// Whether a non-independent generator ran (then [`QMC_NOTE`] is printed).
     pub qmc: bool,
@@ -292,24 +314,26 @@ impl std::fmt::Display for CompareReport {
             .collect();
         writeln!(
             f,
-            "scene {} · backend {} · {} threads · seed {} · {} s per strategy · reference {}",
+            "scene {} · backend {} · {} threads · seed {} · {} per strategy · reference {}",
             self.scene,
             self.backend,
             self.threads,
             self.seed,
-            self.time_s,
+            self.budget,
             spp.join(", ")
         )?;
         let overshoot = self
             .summary
             .iter()
-            .map(|r| r.overshoot_max)
-            .fold(f64::NEG_INFINITY, f64::max);
-        writeln!(
-            f,
-            "largest deviation from the budget: {:+.2} % (a run stops at the last whole pass predicted to fit)",
-            100.0 * overshoot
-        )?;
+            .filter_map(|r| r.overshoot_max)
+            .reduce(f64::max);
+        if let Some(overshoot) = overshoot {
+            writeln!(
+                f,
+                "largest deviation from the budget: {:+.2} % (a run stops at the last whole pass predicted to fit)",
+                100.0 * overshoot
+            )?;
+        }
         for r in &self.references {
             if let Some(floor) = r.noise_floor {
                 writeln!(
@@ -551,7 +575,8 @@ pub fn run(
         seeds: (0..opts.runs as u64)
             .map(|k| opts.seed.wrapping_add(k))
             .collect(),
-        budget_s: opts.time_s,
+        budget_s: opts.budget.seconds(),
+        budget_spp: opts.budget.spp(),
         strategies: strategies.iter().map(|s| s.name()).collect(),
         samplers: generators.iter().map(|g| g.name().to_string()).collect(),
         sampler_note: qmc.then_some(QMC_NOTE),
@@ -576,7 +601,11 @@ pub fn run(
     run_dir.record(&meta, Status::Running)?;
     let mut rows = Vec::new();
     let mut finals = Vec::new();
-    let budget_ms = (opts.time_s * 1000.0).ceil() as u64;
+    // The progress bar counts milliseconds at equal time, passes at equal spp.
+    let bar_len = match opts.budget {
+        Budget::Time(t) => (t * 1000.0).ceil() as u64,
+        Budget::Spp(n) => n,
+    };
     // Strategies (and, within each, samplers) interleaved within each run, so slow drifts in
     // machine load spread over all.
     let pairs: Vec<(&Box<dyn Strategy>, &dyn SampleGenerator)> = strategies
@@ -587,7 +616,7 @@ pub fn run(
         for &(s, g) in &pairs {
             let stem = image_stem(&s.name(), g.name());
             let bar = progress_bar(
-                budget_ms,
+                bar_len,
                 format!("run {run} {:<10}", stem),
                 "{prefix} [{bar:30}] {msg}",
             );
@@ -598,15 +627,26 @@ pub fn run(
                     s.name()
                 ))
             })?;
-            let r = run_strategy(scene, s.as_ref(), g, &reference.image, opts, run, |t| {
-                bar.set_position(t.as_millis() as u64);
-            })?;
+            let r = run_strategy(
+                scene,
+                s.as_ref(),
+                g,
+                &reference.image,
+                opts,
+                run,
+                |t, spp| {
+                    bar.set_position(match opts.budget {
+                        Budget::Time(_) => t.as_millis() as u64,
+                        Budget::Spp(_) => spp,
+                    });
+                },
+            )?;
             bar.finish_and_clear();
             if r.interrupted {
                 // Keep what finished (results.csv is already written), summarise it, record
                 // the interruption; the unfinished strategy leaves no file behind.
                 if !finals.is_empty() {
-                    write_csv(&dir.join("summary.csv"), &summarize(&finals, opts.time_s))?;
+                    write_csv(&dir.join("summary.csv"), &summarize(&finals, opts.budget))?;
                 }
                 return Err(Error::Interrupted(format!(
                     "compare kept {} finished strategy run(s) in {}; `{stem}` (run {run}) was discarded",
@@ -637,7 +677,7 @@ pub fn run(
             run_dir.record(&meta, Status::Running)?;
         }
     }
-    let summary = summarize(&finals, opts.time_s);
+    let summary = summarize(&finals, opts.budget);
     write_csv(&dir.join("summary.csv"), &summary)?;
     run_dir.record(&meta, Status::Complete)?;
     Ok(CompareReport {
@@ -649,7 +689,7 @@ pub fn run(
         backend: scene.tracer.name().to_string(),
         threads: opts.threads,
         seed: opts.seed,
-        time_s: opts.time_s,
+        budget: opts.budget,
         references: references
             .images
             .iter()

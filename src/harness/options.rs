@@ -39,6 +39,61 @@ pub fn check_at_least_one(flag: &str, n: u64) -> Result<()> {
     Ok(())
 }
 
+/// What every strategy of a comparison gets: the same wall-clock time (`--time`, the
+/// default), or the same number of samples per pixel (`--spp`: what a stratified generator
+/// needs, and the axis on which QMC convergence rates are defined).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Budget {
+    /// Seconds of render time per strategy run.
+    Time(f64),
+    /// Passes (samples per pixel) per strategy run.
+    Spp(u64),
+}
+
+impl Budget {
+    /// The bound of the flag that set it (`--time` or `--spp`).
+    pub fn check(&self) -> Result<()> {
+        match *self {
+            Budget::Time(t) => check_seconds("--time", t).map(|_| ()),
+            Budget::Spp(n) => check_at_least_one("--spp", n),
+        }
+    }
+
+    /// The fixed sample count, if this is one.
+    pub fn spp(&self) -> Option<u64> {
+        match *self {
+            Budget::Spp(n) => Some(n),
+            Budget::Time(_) => None,
+        }
+    }
+
+    /// The time budget, if this is one.
+    pub fn seconds(&self) -> Option<f64> {
+        match *self {
+            Budget::Time(t) => Some(t),
+            Budget::Spp(_) => None,
+        }
+    }
+
+    /// The samples per pixel a strategy costing `seconds_per_pass` gets: T / t at equal time,
+    /// N at equal spp. The variance of its mean is then σ² / that (independent samples).
+    pub fn passes(&self, seconds_per_pass: f64) -> f64 {
+        match *self {
+            Budget::Time(t) => t / seconds_per_pass,
+            Budget::Spp(n) => n as f64,
+        }
+    }
+}
+
+impl std::fmt::Display for Budget {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Budget::Time(t) => write!(f, "{t} s"),
+            Budget::Spp(n) => write!(f, "{n} spp"),
+        }
+    }
+}
+
 /// The seeds `seed`, `seed + 1`, … of `runs` runs must all be below 2^64.
 pub fn check_seeds(seed: u64, runs: u32) -> Result<()> {
     if seed.checked_add((runs as u64).saturating_sub(1)).is_none() {
@@ -53,6 +108,14 @@ pub fn check_seeds(seed: u64, runs: u32) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Equal time gives T / t passes; equal spp gives N whatever the cost.
+    #[test]
+    fn passes_per_budget() {
+        assert_eq!(Budget::Time(2.0).passes(0.01), 200.0);
+        assert_eq!(Budget::Spp(64).passes(0.01), 64.0);
+        assert_eq!(Budget::Spp(64).passes(1.0), 64.0);
+    }
 
     #[test]
     fn bounds() {
@@ -69,5 +132,10 @@ mod tests {
         assert!(check_seeds(u64::MAX, 1).is_ok() && check_seeds(u64::MAX - 1, 2).is_ok());
         let e = check_seeds(u64::MAX, 2).unwrap_err().to_string();
         assert!(e.contains("--seed") && e.contains("--runs 2"), "{e}");
+        let e = Budget::Spp(0).check().unwrap_err().to_string();
+        assert!(e.contains("--spp"), "{e}");
+        let e = Budget::Time(0.0).check().unwrap_err().to_string();
+        assert!(e.contains("--time"), "{e}");
+        assert!(Budget::Spp(1).check().is_ok() && Budget::Time(1.0).check().is_ok());
     }
 }

@@ -5,11 +5,12 @@
 //! strategies only while the floor is small beside their errors, so the reference must be
 //! sized by the errors it will be compared with. A short pilot of each strategy measures its
 //! per-sample variance σ² (mean over pixels and channels) and its time per pass t; at the
-//! budget T it predicts RMSE ≈ √(σ² t / T), the model `summary::predicted_rmse` checks after
+//! budget T it predicts RMSE ≈ √(σ² t / T) (at a fixed N passes, √(σ²/N)), the model `summary::predicted_rmse` checks after
 //! the fact. The reference then renders, with the strategy of the smallest σ² t (Veach's
 //! efficiency), until its floor √(σ²_ref / N) is at most `fraction` of the smallest predicted
 //! RMSE, or until a time cap.
 
+use super::options::Budget;
 use crate::error::Result;
 use crate::film::Film;
 use crate::math::mix64;
@@ -39,9 +40,9 @@ pub struct Pilot {
 }
 
 impl Pilot {
-    /// The RMSE predicted for a budget of `budget_s` seconds.
-    pub fn predicted_rmse(&self, budget_s: f64) -> f64 {
-        (self.sample_variance * self.seconds_per_pass / budget_s).sqrt()
+    /// The RMSE predicted for `budget`: √(σ² / passes), with T / t passes at equal time.
+    pub fn predicted_rmse(&self, budget: Budget) -> f64 {
+        (self.sample_variance / budget.passes(self.seconds_per_pass)).sqrt()
     }
 
     /// σ² t: the work to reach a given MSE (smaller is better: Veach's efficiency inverted).
@@ -96,8 +97,8 @@ pub struct Plan {
     pub predicted_s: f64,
 }
 
-/// One plan per integrand among `pilots`, for a budget of `budget_s` per strategy.
-pub fn plan(pilots: &[Pilot], budget_s: f64, fraction: f64) -> Vec<Plan> {
+/// One plan per integrand among `pilots`, for `budget` per strategy.
+pub fn plan(pilots: &[Pilot], budget: Budget, fraction: f64) -> Vec<Plan> {
     let mut integrands: Vec<Integrand> = Vec::new();
     for p in pilots {
         if !integrands.contains(&p.integrand) {
@@ -109,11 +110,11 @@ pub fn plan(pilots: &[Pilot], budget_s: f64, fraction: f64) -> Vec<Plan> {
         .filter_map(|integrand| {
             let mine: Vec<&Pilot> = pilots.iter().filter(|p| p.integrand == integrand).collect();
             let smallest = mine.iter().min_by(|a, b| {
-                a.predicted_rmse(budget_s)
-                    .total_cmp(&b.predicted_rmse(budget_s))
+                a.predicted_rmse(budget)
+                    .total_cmp(&b.predicted_rmse(budget))
             })?;
             let best = mine.iter().min_by(|a, b| a.cost().total_cmp(&b.cost()))?;
-            let smallest_rmse = smallest.predicted_rmse(budget_s);
+            let smallest_rmse = smallest.predicted_rmse(budget);
             let target_floor = fraction * MARGIN * smallest_rmse;
             // σ²/N ≤ target² ⇔ N ≥ σ²/target²; a noise-free integrand needs one pass.
             let spp = if target_floor > 0.0 {
@@ -159,7 +160,7 @@ mod tests {
     fn plan_picks_the_most_efficient_strategy_and_meets_the_target() {
         // `cheap`: σ² 4, 1 ms per pass (cost 4e-3); `good`: σ² 1, 10 ms (cost 1e-2).
         let pilots = [p("good", 1.0, 0.01), p("cheap", 4.0, 0.001)];
-        let plans = plan(&pilots, 2.0, 0.1);
+        let plans = plan(&pilots, Budget::Time(2.0), 0.1);
         assert_eq!(plans.len(), 1);
         let pl = &plans[0];
         assert_eq!(pl.strategy, "cheap");
@@ -175,9 +176,27 @@ mod tests {
         assert!((pl.predicted_s - pl.predicted_spp as f64 * 0.001).abs() < 1e-12);
     }
 
+    /// At equal spp the smallest predicted RMSE is the smallest σ² (time per pass no longer
+    /// buys samples), while the reference is still rendered by the most efficient strategy.
+    #[test]
+    fn at_equal_spp_the_target_follows_the_smallest_variance() {
+        let pilots = [p("good", 1.0, 0.01), p("cheap", 4.0, 0.001)];
+        let pl = &plan(&pilots, Budget::Spp(100), 0.1)[0];
+        assert_eq!(
+            (pl.strategy.as_str(), pl.smallest_by.as_str()),
+            ("cheap", "good")
+        );
+        assert!((pl.smallest_rmse - (1.0f64 / 100.0).sqrt()).abs() < 1e-15);
+        let floor = (4.0 / pl.predicted_spp as f64).sqrt();
+        assert!(
+            floor <= pl.target_floor
+                && (4.0 / (pl.predicted_spp - 1) as f64).sqrt() > pl.target_floor
+        );
+    }
+
     #[test]
     fn a_noise_free_integrand_needs_few_passes() {
-        let plans = plan(&[p("a", 0.0, 0.01)], 1.0, 0.1);
+        let plans = plan(&[p("a", 0.0, 0.01)], Budget::Time(1.0), 0.1);
         assert_eq!(plans[0].predicted_spp, MIN_PASSES);
     }
 }

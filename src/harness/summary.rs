@@ -3,6 +3,7 @@
 //! best strategy (Celarek et al. 2019, "Quantifying the Error of Light Transport Algorithms").
 
 use super::compare::ResultRow;
+use super::options::Budget;
 use crate::stats::{fit_line, holm_adjust, mean_ci, welch_t_test};
 use serde::{Deserialize, Serialize};
 
@@ -81,10 +82,12 @@ pub struct SummaryRow {
     pub integrand: String,
     pub strategy: String,
     pub runs: usize,
-    pub budget_s: f64,
+    /// The time budget per run (`--time`); empty at equal spp (`budget_spp`).
+    pub budget_s: Option<f64>,
     pub time_s_mean: f64,
-    /// max over runs of time_s / budget − 1 (negative: stopped before the budget).
-    pub overshoot_max: f64,
+    /// max over runs of time_s / budget − 1 (negative: stopped before the budget); empty at
+    /// equal spp, where every run renders exactly the budget.
+    pub overshoot_max: Option<f64>,
     pub spp_mean: f64,
     pub rmse_mean: f64,
     /// Half-width of the 95 % Student-t interval of the mean over runs (empty below 2 runs).
@@ -105,7 +108,8 @@ pub struct SummaryRow {
     /// the debiased one may be zero or negative); empty when the relMSE is 0 (an exact image).
     pub efficiency: Option<f64>,
     /// √(σ² · (t/spp) / T + floor²): the RMSE expected from the per-sample variance σ², the
-    /// measured cost per sample t/spp and the budget T, plus the reference's noise floor.
+    /// measured cost per sample t/spp and the budget T, plus the reference's noise floor
+    /// (at equal spp N: √(σ²/N + floor²)).
     /// Empty for a non-independent sampler: that formula assumes independent samples, and
     /// the across-pass variance of correlated samples is not σ².
     pub predicted_rmse: Option<f64>,
@@ -127,6 +131,8 @@ pub struct SummaryRow {
     /// The sample generator; (strategy, sampler) is a run's identity. Appended last so the
     /// earlier columns keep their positions.
     pub sampler: String,
+    /// The sample budget per run (`--spp`); empty at equal time (`budget_s`).
+    pub budget_spp: Option<u64>,
 }
 
 /// A summary key: (integrand, strategy, sampler).
@@ -142,7 +148,7 @@ fn key_of(f: &FinalRun) -> Key<'_> {
 
 /// One summary row per (integrand, strategy, sampler), sorted per integrand by the ranking
 /// metric (the debiased relMSE), integrands in order of first appearance.
-pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
+pub fn summarize(finals: &[FinalRun], budget: Budget) -> Vec<SummaryRow> {
     let mut keys: Vec<Key> = Vec::new();
     for f in finals {
         let k = key_of(f);
@@ -173,7 +179,7 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
                     let cost = f.row.time_s / f.row.spp as f64;
                     let floor2 = f.reference_noise_floor.map_or(0.0, |x| x * x);
                     f.mean_sample_variance
-                        .map(|v| (v * cost / budget_s + floor2).sqrt())
+                        .map(|v| (v / budget.passes(cost) + floor2).sqrt())
                 })
                 .collect();
             SummaryRow {
@@ -182,12 +188,12 @@ pub fn summarize(finals: &[FinalRun], budget_s: f64) -> Vec<SummaryRow> {
                 strategy: k.1.to_string(),
                 sampler: k.2.to_string(),
                 runs: g.len(),
-                budget_s,
+                budget_s: budget.seconds(),
+                budget_spp: budget.spp(),
                 time_s_mean: time.mean,
-                overshoot_max: g
-                    .iter()
-                    .map(|f| f.row.time_s / budget_s - 1.0)
-                    .fold(f64::NEG_INFINITY, f64::max),
+                overshoot_max: budget
+                    .seconds()
+                    .and_then(|t| g.iter().map(|f| f.row.time_s / t - 1.0).reduce(f64::max)),
                 spp_mean: mean_ci(&pick(&|f| f.row.spp as f64), LEVEL).mean,
                 rmse_mean: rmse.mean,
                 rmse_ci95: rmse.half_width,
@@ -363,7 +369,7 @@ mod tests {
             finals.push(fr("b", k, 2.0 + 0.01 * e)); // clearly worse
             finals.push(fr("c", k, 1.001 - 0.02 * e)); // within the noise
         }
-        let rows = summarize(&finals, 1.0);
+        let rows = summarize(&finals, Budget::Time(1.0));
         let get = |s: &str| rows.iter().find(|r| r.strategy == s).unwrap();
         assert_eq!(get("a").vs_best, "best");
         assert_eq!(get("b").vs_best, "worse");
@@ -377,6 +383,27 @@ mod tests {
         assert!(noise_floor_warnings(&rows, 0.1).is_empty());
     }
 
+    /// At equal spp N the prediction is √(σ²/N + floor²) whatever the time per sample, the
+    /// budget is N (no seconds, no overshoot); at equal time it uses the cost (the control).
+    #[test]
+    fn an_spp_budget_predicts_from_the_sample_count() {
+        let mut slow = fr("a", 0, 1.0);
+        slow.row.time_s = 5.0; // 50 ms per sample: irrelevant at equal spp
+        let rows = summarize(&[slow.clone()], Budget::Spp(100));
+        let r = &rows[0];
+        assert!((r.predicted_rmse.unwrap() - (0.01f64 / 100.0 + 1e-6).sqrt()).abs() < 1e-15);
+        assert_eq!(
+            (r.budget_s, r.budget_spp, r.overshoot_max),
+            (None, Some(100), None)
+        );
+        let rows = summarize(&[slow], Budget::Time(1.0));
+        let r = &rows[0];
+        // T / c = 1 s / 50 ms = 20 passes.
+        assert!((r.predicted_rmse.unwrap() - (0.01f64 / 20.0 + 1e-6).sqrt()).abs() < 1e-15);
+        assert_eq!((r.budget_s, r.budget_spp), (Some(1.0), None));
+        assert!((r.overshoot_max.unwrap() - 4.0).abs() < 1e-12);
+    }
+
     /// The bar is the smallest *expected* RMSE: a strategy whose one run came out lucky (a
     /// realized RMSE far below its prediction) does not trigger the warning, while a floor
     /// above the share of the smallest prediction does (the negative control); a row without
@@ -384,7 +411,7 @@ mod tests {
     #[test]
     fn the_floor_warning_is_against_the_smallest_expected_rmse() {
         let finals: Vec<FinalRun> = (0..3).map(|k| fr("a", k, 1.0)).collect();
-        let base = summarize(&finals, 1.0).remove(0);
+        let base = summarize(&finals, Budget::Time(1.0)).remove(0);
         let row = |strategy: &str, predicted: Option<f64>, measured: f64, floor: f64| SummaryRow {
             strategy: strategy.into(),
             predicted_rmse: predicted,
@@ -442,7 +469,7 @@ mod tests {
                     finals.push(fr(&name, k, 1.0 + 0.1 * normal(key)));
                 }
             }
-            let rows = summarize(&finals, 1.0);
+            let rows = summarize(&finals, Budget::Time(1.0));
             holm_errors += rows.iter().any(|r| r.vs_best == "worse") as u32;
             raw_errors += rows
                 .iter()
@@ -493,11 +520,11 @@ mod tests {
         a.reference_relmse_floor = 0.01;
         assert!((a.mse_debiased() - (0.04 - 1e-6)).abs() < 1e-15);
         assert!((a.relmse_debiased() - 0.03).abs() < 1e-15);
-        let rows = summarize(&[a.clone()], 1.0);
+        let rows = summarize(&[a.clone()], Budget::Time(1.0));
         assert!((rows[0].relmse_debiased_mean - 0.03).abs() < 1e-15);
         assert_eq!(rows[0].vs_best, "best");
         let b = fr("b", 0, 0.02);
-        let rows = summarize(&[a, b], 1.0);
+        let rows = summarize(&[a, b], Budget::Time(1.0));
         assert_eq!(rows[0].strategy, "b", "sorted by the ranking metric");
         assert_eq!(rows[1].vs_best, "one run: no test");
     }
@@ -515,7 +542,7 @@ mod tests {
             q.mean_sample_variance = None;
             finals.push(q);
         }
-        let rows = summarize(&finals, 1.0);
+        let rows = summarize(&finals, Budget::Time(1.0));
         assert_eq!(rows.len(), 2);
         assert_eq!(
             (rows[0].sampler.as_str(), rows[0].vs_best.as_str()),
