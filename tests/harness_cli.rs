@@ -161,6 +161,8 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
     for f in [
         "rmse_vs_time.png",
         "rmse_vs_time.svg",
+        "rmse_vs_spp.png",
+        "rmse_vs_spp.svg",
         "strip.png",
         "variance.png",
     ] {
@@ -751,6 +753,14 @@ fn compare_at_equal_spp() {
             assert_eq!(predicted, "", "a non-independent row predicted: {summary}");
         }
     }
+    // The spp chart: x in samples per pixel, one curve per pair with its slope.
+    let (code, _, stderr) = dibench(&["plot", run_dir.to_str().unwrap()], dir.path());
+    assert_eq!(code, 0, "{stderr}");
+    let svg = std::fs::read_to_string(run_dir.join("plots/rmse_vs_spp.svg")).unwrap();
+    assert!(
+        svg.contains("samples per pixel") && svg.contains("light [stratified], slope"),
+        "spp chart"
+    );
     let meta = std::fs::read_to_string(run_dir.join("run.json")).unwrap();
     assert!(
         meta.contains("\"budget_spp\": 16") && !meta.contains("budget_s\""),

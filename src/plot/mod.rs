@@ -2,6 +2,8 @@
 //! - `rmse_vs_time.png` / `.svg`: log-log RMSE against render time per strategy, mean over
 //!   runs with the 95 % Student-t band, and a slope −½ guide (RMSE ∝ t^−½ for an unbiased
 //!   estimator at constant cost per sample);
+//! - `rmse_vs_spp.png` / `.svg`: the same against samples per pixel, with the slope over
+//!   ln spp (the axis of QMC convergence rates, and of a `compare --spp` run);
 //! - `variance.png`: per-pixel variance of the mean (`<strategy>.variance.exr`, mean of the RGB
 //!   channels), log10 on one shared scale with a colour bar;
 //! - `strip.png`: the equal-time images (run 0) side by side, clamped to [0, 1] and sRGB-encoded.
@@ -39,7 +41,30 @@ fn plot_err(path: &Path, e: impl std::fmt::Display) -> Error {
     }
 }
 
-/// One strategy's curve: per checkpoint, mean time, mean RMSE and CI half-width (if ≥ 2 runs).
+/// The x axis of an RMSE chart.
+#[derive(Clone, Copy, PartialEq)]
+enum Axis {
+    Time,
+    Spp,
+}
+
+impl Axis {
+    fn stem(self) -> &'static str {
+        match self {
+            Axis::Time => "rmse_vs_time",
+            Axis::Spp => "rmse_vs_spp",
+        }
+    }
+    fn x(self, r: &ResultRow) -> f64 {
+        match self {
+            Axis::Time => r.time_s,
+            Axis::Spp => r.spp as f64,
+        }
+    }
+}
+
+/// One strategy's curve: per checkpoint, mean x (time or spp), mean RMSE and CI half-width
+/// (if ≥ 2 runs).
 struct Curve {
     label: String,
     points: Vec<(f64, f64, Option<f64>)>,
@@ -47,7 +72,7 @@ struct Curve {
 
 /// One curve per (strategy, sampler, integrand): the sampler is part of a run's identity, and
 /// part of the label when the run used more than one or a non-default one.
-fn curves(rows: &[ResultRow]) -> Vec<Curve> {
+fn curves(rows: &[ResultRow], axis: Axis) -> Vec<Curve> {
     let mut keys: Vec<(String, String, String)> = Vec::new();
     for r in rows {
         let k = (r.strategy.clone(), r.sampler.clone(), r.integrand.clone());
@@ -74,7 +99,7 @@ fn curves(rows: &[ResultRow]) -> Vec<Curve> {
                 .iter()
                 .map(|&c| {
                     let at: Vec<&&ResultRow> = mine.iter().filter(|r| r.checkpoint == c).collect();
-                    let t = at.iter().map(|r| r.time_s).sum::<f64>() / at.len() as f64;
+                    let t = at.iter().map(|r| axis.x(r)).sum::<f64>() / at.len() as f64;
                     let rmse: Vec<f64> = at.iter().map(|r| r.rmse).collect();
                     let ci = mean_ci(&rmse, crate::harness::summary::LEVEL);
                     (t, ci.mean, ci.half_width)
@@ -92,7 +117,11 @@ fn curves(rows: &[ResultRow]) -> Vec<Curve> {
                         .filter(|r| r.run == k)
                         .map(|r| (*r).clone())
                         .collect();
-                    crate::harness::summary::convergence_slopes(&of_run).0
+                    let (time, spp) = crate::harness::summary::convergence_slopes(&of_run);
+                    match axis {
+                        Axis::Time => time,
+                        Axis::Spp => spp,
+                    }
                 })
                 .collect();
             let strategy = if label_sampler {
@@ -114,11 +143,15 @@ fn curves(rows: &[ResultRow]) -> Vec<Curve> {
         .collect()
 }
 
-fn draw_rmse<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, curves: &[Curve]) -> Result<()>
+fn draw_rmse<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    curves: &[Curve],
+    axis: Axis,
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
-    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| plot_err(Path::new("rmse_vs_time"), e);
+    let e = |e: DrawingAreaErrorKind<DB::ErrorType>| plot_err(Path::new(axis.stem()), e);
     root.fill(&WHITE).map_err(e)?;
     let all = curves.iter().flat_map(|c| c.points.iter());
     let (mut t0, mut t1, mut y0, mut y1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
@@ -129,11 +162,14 @@ where
         y1 = y1.max(y);
     }
     if !(t0 > 0.0 && y0 > 0.0 && t1 >= t0) {
-        return Err(plot_err(Path::new("rmse_vs_time"), "no positive data"));
+        return Err(plot_err(Path::new(axis.stem()), "no positive data"));
     }
     let mut chart = ChartBuilder::on(&root)
         .caption(
-            "RMSE against render time (mean, 95 % CI)",
+            match axis {
+                Axis::Time => "RMSE against render time (mean, 95 % CI)",
+                Axis::Spp => "RMSE against samples per pixel (mean, 95 % CI)",
+            },
             ("sans-serif", 22),
         )
         .margin(12)
@@ -146,7 +182,10 @@ where
         .map_err(e)?;
     chart
         .configure_mesh()
-        .x_desc("time [s]")
+        .x_desc(match axis {
+            Axis::Time => "time [s]",
+            Axis::Spp => "samples per pixel",
+        })
         .y_desc("RMSE")
         .x_labels(6)
         .y_labels(6)
@@ -380,14 +419,16 @@ pub fn plot_run(run_dir: &Path) -> Result<Vec<PathBuf>> {
     crate::output::check_output_dir(&dir, "RUN_DIR")?;
     let mut written = Vec::new();
 
-    let c = curves(&rows_on_axis);
     let size = (900, 620);
-    let p = dir.join("rmse_vs_time.png");
-    png_figure(&p, size, |root| draw_rmse(root, &c))?;
-    written.push(p);
-    let p = dir.join("rmse_vs_time.svg");
-    svg_figure(&p, size, |root| draw_rmse(root, &c))?;
-    written.push(p);
+    for axis in [Axis::Time, Axis::Spp] {
+        let c = curves(&rows_on_axis, axis);
+        let p = dir.join(format!("{}.png", axis.stem()));
+        png_figure(&p, size, |root| draw_rmse(root, &c, axis))?;
+        written.push(p);
+        let p = dir.join(format!("{}.svg", axis.stem()));
+        svg_figure(&p, size, |root| draw_rmse(root, &c, axis))?;
+        written.push(p);
+    }
 
     // One image per (strategy, sampler), by its file stem (`compare::image_stem`).
     let mut names: Vec<String> = Vec::new();
