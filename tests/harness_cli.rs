@@ -753,6 +753,46 @@ fn compare_at_equal_spp() {
             assert_eq!(predicted, "", "a non-independent row predicted: {summary}");
         }
     }
+    // Every image says how it was made (strategy, sampler, spp, seed, …) in its EXR header.
+    let p = dibench::output::read_provenance(&run_dir.join("light.stratified.exr"))
+        .unwrap()
+        .expect("no provenance in light.stratified.exr");
+    assert_eq!(
+        (
+            p.strategy.as_str(),
+            p.sampler.as_str(),
+            p.integrand.as_str()
+        ),
+        ("light", "stratified", "direct")
+    );
+    assert_eq!(
+        (p.spp, p.seed, p.threads, p.content.as_str()),
+        (16, 1, 1, "radiance")
+    );
+    assert!(p.render_time_s > 0.0 && !p.scene_hash.is_empty() && p.backend == "packet");
+    let v = dibench::output::read_provenance(&run_dir.join("cosine.variance.exr"))
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        (v.strategy.as_str(), v.content.as_str()),
+        ("cosine", "variance of the mean")
+    );
+    let reference = std::fs::read_dir(dir.path().join("out/tiny/reference"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| {
+            let n = p.file_name().unwrap().to_string_lossy().to_string();
+            n.ends_with(".exr") && !n.ends_with(".variance.exr")
+        })
+        .unwrap();
+    let r = dibench::output::read_provenance(&reference)
+        .unwrap()
+        .unwrap();
+    assert_eq!(
+        (r.spp, r.sampler.as_str(), r.scene_hash),
+        (64, "independent", p.scene_hash)
+    );
     // The spp chart: x in samples per pixel, one curve per pair with its slope.
     let (code, _, stderr) = dibench(&["plot", run_dir.to_str().unwrap()], dir.path());
     assert_eq!(code, 0, "{stderr}");

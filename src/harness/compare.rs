@@ -13,7 +13,7 @@ use crate::film::{Film, Image};
 use crate::metrics::{relmse, rmse};
 use crate::output::run_dir::{RunDir, Status};
 use crate::output::store::Store;
-use crate::output::{write_csv, write_exr};
+use crate::output::{Provenance, write_csv, write_exr_with};
 use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::sampling::{SampleGenerator, Setup};
@@ -655,9 +655,29 @@ pub fn run(
                 )));
             }
             if run == 0 {
-                write_exr(&dir.join(format!("{stem}.exr")), &r.image)?;
+                let last = r.rows.last();
+                let provenance = Provenance {
+                    scene: scene.scene.name.clone(),
+                    scene_hash: scene.scene.content_hash.clone(),
+                    strategy: s.name(),
+                    integrand: s.integrand().name().to_string(),
+                    sampler: g.name().to_string(),
+                    content: "radiance".into(),
+                    spp: last.map_or(0, |l| l.spp),
+                    render_time_s: last.map_or(0.0, |l| l.time_s),
+                    seed: opts.seed.wrapping_add(run as u64),
+                    backend: scene.tracer.name().to_string(),
+                    threads: opts.threads,
+                    version: VERSION.to_string(),
+                    commit: COMMIT.to_string(),
+                };
+                write_exr_with(&dir.join(format!("{stem}.exr")), &r.image, &provenance)?;
                 if g.independent_samples() {
-                    write_exr(&dir.join(format!("{stem}.variance.exr")), &r.variance)?;
+                    write_exr_with(
+                        &dir.join(format!("{stem}.variance.exr")),
+                        &r.variance,
+                        &provenance.variance(),
+                    )?;
                 }
             }
             let Some(last) = FinalRun::new(

@@ -39,6 +39,27 @@ pub struct ReferenceMeta {
     pub commit: String,
 }
 
+impl ReferenceMeta {
+    /// What the reference's EXR headers say of it (references use independent samples).
+    pub fn provenance(&self) -> crate::output::Provenance {
+        crate::output::Provenance {
+            scene: self.scene.clone(),
+            scene_hash: self.scene_hash.clone(),
+            strategy: self.strategy.clone(),
+            integrand: self.integrand.clone(),
+            sampler: crate::sampling::GENERATORS[0].name().to_string(),
+            content: "radiance".into(),
+            spp: self.spp,
+            render_time_s: self.wall_time_s,
+            seed: self.seed,
+            backend: self.backend.clone(),
+            threads: self.threads,
+            version: self.dibench_version.clone(),
+            commit: self.commit.clone(),
+        }
+    }
+}
+
 /// How a reference was rendered, as `dibench reference` prints it after the file's path.
 impl std::fmt::Display for ReferenceMeta {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -268,18 +289,20 @@ pub fn save(
     variance: &Image,
     meta: &ReferenceMeta,
 ) -> Result<PathBuf> {
+    let provenance = meta.provenance();
+    let of_variance = provenance.variance();
     unit.commit(
         meta,
         vec![
             NewFile {
                 role: "image",
                 ext: "exr",
-                write: Box::new(|p| encode_exr(p, image, p)),
+                write: Box::new(|p| encode_exr(p, image, p, Some(&provenance))),
             },
             NewFile {
                 role: "variance",
                 ext: "variance.exr",
-                write: Box::new(|p| encode_exr(p, variance, p)),
+                write: Box::new(|p| encode_exr(p, variance, p, Some(&of_variance))),
             },
         ],
     )

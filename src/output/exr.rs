@@ -1,5 +1,7 @@
 //! RGB EXR files: written as f32 scan lines, read with the header checked before any pixel
-//! memory is allocated (a header may claim any size).
+//! memory is allocated (a header may claim any size). An image the harness renders carries
+//! its [`Provenance`] as header attributes `dibench:<field>` (what `oiiotool --info -v` and
+//! the `exr` crate read back).
 
 use crate::bounded;
 use crate::error::{Error as DibenchError, Result};
@@ -7,15 +9,105 @@ use crate::film::Image as RgbImage;
 use std::io::Cursor;
 use std::path::Path;
 
+/// How an image was made, written into its EXR header: one text attribute per field
+/// (`dibench:strategy`, …; numbers in decimal, the render time in seconds as a double), plus
+/// the standard `software` attribute. Text is UTF-8.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Provenance {
+    pub scene: String,
+    /// The scene's content hash (its TOML and every file it references).
+    pub scene_hash: String,
+    pub strategy: String,
+    pub integrand: String,
+    pub sampler: String,
+    /// What the pixels are: `radiance` (the mean estimate) or `variance of the mean`.
+    pub content: String,
+    pub spp: u64,
+    /// Render time of the passes in the image, in seconds.
+    pub render_time_s: f64,
+    pub seed: u64,
+    pub backend: String,
+    pub threads: usize,
+    pub version: String,
+    pub commit: String,
+}
+
+/// The attribute-name prefix of [`Provenance`]'s fields.
+pub const ATTRIBUTE_PREFIX: &str = "dibench:";
+
+impl Provenance {
+    /// The same provenance for the image's variance-of-the-mean companion.
+    pub fn variance(&self) -> Provenance {
+        Provenance {
+            content: "variance of the mean".into(),
+            ..self.clone()
+        }
+    }
+
+    fn text_fields(&self) -> [(&'static str, String); 12] {
+        [
+            ("scene", self.scene.clone()),
+            ("scene_hash", self.scene_hash.clone()),
+            ("strategy", self.strategy.clone()),
+            ("integrand", self.integrand.clone()),
+            ("sampler", self.sampler.clone()),
+            ("content", self.content.clone()),
+            ("spp", self.spp.to_string()),
+            ("seed", self.seed.to_string()),
+            ("backend", self.backend.clone()),
+            ("threads", self.threads.to_string()),
+            ("version", self.version.clone()),
+            ("commit", self.commit.clone()),
+        ]
+    }
+
+    fn attributes(
+        &self,
+    ) -> Vec<(
+        exr::meta::attribute::Text,
+        exr::meta::attribute::AttributeValue,
+    )> {
+        use exr::meta::attribute::{AttributeValue, Text};
+        let name =
+            |k: &str| Text::from_slice_unchecked(format!("{ATTRIBUTE_PREFIX}{k}").as_bytes());
+        let mut out: Vec<_> = self
+            .text_fields()
+            .into_iter()
+            .map(|(k, v)| {
+                (
+                    name(k),
+                    AttributeValue::Text(Text::from_slice_unchecked(v.as_bytes())),
+                )
+            })
+            .collect();
+        out.push((
+            name("render_time_s"),
+            AttributeValue::F64(self.render_time_s),
+        ));
+        out
+    }
+}
+
 /// RGB f32 EXR, ZIP-compressed scan lines (tiled files trip up some readers, e.g. tinyexr),
 /// written atomically.
 pub fn write_exr(path: &Path, img: &RgbImage) -> Result<()> {
-    super::write_atomic(path, |tmp| encode_exr(tmp, img, path))
+    super::write_atomic(path, |tmp| encode_exr(tmp, img, path, None))
 }
 
-/// Writes `img` as an EXR to the file `to` directly (errors name `named`): for writers that
-/// already write to a temporary file, such as a store commit.
-pub fn encode_exr(to: &Path, img: &RgbImage, named: &Path) -> Result<()> {
+/// [`write_exr`] with the image's provenance in the header.
+pub fn write_exr_with(path: &Path, img: &RgbImage, provenance: &Provenance) -> Result<()> {
+    super::write_atomic(path, |tmp| encode_exr(tmp, img, path, Some(provenance)))
+}
+
+/// Writes `img` as an EXR to the file `to` directly (errors name `named`), with `provenance`
+/// in its header if given: for writers that already write to a temporary file, such as a
+/// store commit.
+pub fn encode_exr(
+    to: &Path,
+    img: &RgbImage,
+    named: &Path,
+    provenance: Option<&Provenance>,
+) -> Result<()> {
     use exr::prelude::*;
     {
         let w = img.width as usize;
@@ -24,9 +116,16 @@ pub fn encode_exr(to: &Path, img: &RgbImage, named: &Path) -> Result<()> {
             blocks: Blocks::ScanLines,
             line_order: LineOrder::Increasing,
         };
+        let mut attributes = LayerAttributes::default();
+        if let Some(p) = provenance {
+            attributes.software_name = Some(Text::from_slice_unchecked(
+                format!("dibench {} ({})", p.version, p.commit).as_bytes(),
+            ));
+            attributes.other.extend(p.attributes());
+        }
         let layer = Layer::new(
             (w, img.height as usize),
-            LayerAttributes::default(),
+            attributes,
             enc,
             SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
                 let p = img.pixels[y * w + x];
@@ -41,6 +140,70 @@ pub fn encode_exr(to: &Path, img: &RgbImage, named: &Path) -> Result<()> {
                 message: format!("cannot write EXR: {e}"),
             })
     }
+}
+
+/// The [`Provenance`] in the header of the EXR file `path` (None when it has none: written
+/// before it was recorded, or by another program); a field that is missing or does not parse
+/// is an error naming the file and the attribute. Reads the header only.
+pub fn read_provenance(path: &Path) -> Result<Option<Provenance>> {
+    use exr::meta::attribute::AttributeValue;
+    let bytes = bounded::read_file(path, 0)?;
+    let meta =
+        exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false).map_err(|e| {
+            DibenchError::Parse {
+                path: path.into(),
+                message: format!("not a readable EXR image: {e}"),
+            }
+        })?;
+    let Some(header) = meta.headers.first() else {
+        return Ok(None);
+    };
+    let other = &header.own_attributes.other;
+    let get = |k: &str| {
+        other
+            .iter()
+            .find(|(name, _)| name.bytes() == format!("{ATTRIBUTE_PREFIX}{k}").as_bytes())
+            .map(|(_, v)| v)
+    };
+    if get("strategy").is_none() {
+        return Ok(None);
+    }
+    let bad = |k: &str, why: &str| DibenchError::Parse {
+        path: path.into(),
+        message: format!("header attribute `{ATTRIBUTE_PREFIX}{k}`: {why}"),
+    };
+    let text = |k: &str| -> Result<String> {
+        match get(k) {
+            Some(AttributeValue::Text(t)) => Ok(String::from_utf8_lossy(t.bytes()).into_owned()),
+            Some(_) => Err(bad(k, "not text")),
+            None => Err(bad(k, "missing")),
+        }
+    };
+    let number = |k: &str| -> Result<u64> {
+        text(k)?
+            .parse::<u64>()
+            .map_err(|e| bad(k, &format!("not a whole number: {e}")))
+    };
+    let render_time_s = match get("render_time_s") {
+        Some(AttributeValue::F64(t)) => *t,
+        Some(_) => return Err(bad("render_time_s", "not a double")),
+        None => return Err(bad("render_time_s", "missing")),
+    };
+    Ok(Some(Provenance {
+        scene: text("scene")?,
+        scene_hash: text("scene_hash")?,
+        strategy: text("strategy")?,
+        integrand: text("integrand")?,
+        sampler: text("sampler")?,
+        content: text("content")?,
+        spp: number("spp")?,
+        render_time_s,
+        seed: number("seed")?,
+        backend: text("backend")?,
+        threads: number("threads")? as usize,
+        version: text("version")?,
+        commit: text("commit")?,
+    }))
 }
 
 /// Reads the first RGB(A) layer of an EXR file (a regular file, its size and then its header
@@ -145,6 +308,55 @@ mod tests {
             1,
             "temporary files left behind: {leftovers:?}"
         );
+    }
+
+    /// Every field round-trips through the header (a non-ASCII scene name included); an
+    /// image written without provenance reads as None; a damaged field is an error naming the
+    /// file and the attribute (the negative control: a reader that ignored the fields, or
+    /// wrote one under the wrong name, fails the equality).
+    #[test]
+    fn provenance_round_trips_through_the_header() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = Provenance {
+            scene: "cornell-ü".into(),
+            scene_hash: "abc123".into(),
+            strategy: "mis-power".into(),
+            integrand: "direct".into(),
+            sampler: "sobol".into(),
+            content: "radiance".into(),
+            spp: 1 << 40,
+            render_time_s: 1.25,
+            seed: u64::MAX,
+            backend: "packet".into(),
+            threads: 2,
+            version: "0.1.0".into(),
+            commit: "deadbeef".into(),
+        };
+        let path = dir.path().join("a.exr");
+        write_exr_with(&path, &image(3, 2), &p).unwrap();
+        assert_eq!(read_provenance(&path).unwrap(), Some(p.clone()));
+        assert_eq!(read_exr(&path).unwrap(), image(3, 2));
+        let v = dir.path().join("v.exr");
+        write_exr_with(&v, &image(3, 2), &p.variance()).unwrap();
+        assert_eq!(
+            read_provenance(&v).unwrap().unwrap().content,
+            "variance of the mean"
+        );
+        let plain = dir.path().join("plain.exr");
+        write_exr(&plain, &image(3, 2)).unwrap();
+        assert_eq!(read_provenance(&plain).unwrap(), None);
+        // The spp attribute's text damaged in place (same length: "109951162777x").
+        let mut bytes = std::fs::read(&path).unwrap();
+        let digits = (1u64 << 40).to_string();
+        let at = bytes
+            .windows(digits.len())
+            .position(|w| w == digits.as_bytes())
+            .unwrap();
+        bytes[at + digits.len() - 1] = b'x';
+        let bad = dir.path().join("bad.exr");
+        std::fs::write(&bad, &bytes).unwrap();
+        let e = read_provenance(&bad).unwrap_err().to_string();
+        assert!(e.contains("bad.exr") && e.contains("dibench:spp"), "{e}");
     }
 
     #[test]

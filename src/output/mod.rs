@@ -15,7 +15,9 @@ mod exr;
 pub mod run_dir;
 pub mod store;
 
-pub use exr::{decode_exr, encode_exr, read_exr, write_exr};
+pub use exr::{
+    Provenance, decode_exr, encode_exr, read_exr, read_provenance, write_exr, write_exr_with,
+};
 
 use crate::error::{Error, Result};
 use serde::Serialize;
