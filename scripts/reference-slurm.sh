@@ -5,9 +5,13 @@
 #   # when all tasks are done (or: sbatch --dependency=afterok:<jobid> --wrap ...):
 #   cargo run --release -- merge cornell --out results
 #
+# The output root is results/ (relative to the submit directory) unless DIBENCH_OUT names
+# another: sbatch --export=ALL,DIBENCH_OUT=/shared/refs --array=0-15 scripts/reference-slurm.sh …
+# then merge with --out /shared/refs. scripts/test-slurm.sh runs all this on a one-node cluster.
+#
 # Each task renders shard $SLURM_ARRAY_TASK_ID of $SLURM_ARRAY_TASK_COUNT (passes i, i+n, …
 # of SPP) with the same random streams a single process would use, into
-# results/<scene>/reference/shards/; `dibench merge` combines them losslessly. The output
+# <out>/<scene>/reference/shards/; `dibench merge` combines them losslessly. The output
 # root must be on a filesystem every node sees.
 #SBATCH --job-name=dibench-reference
 #SBATCH --cpus-per-task=16
@@ -23,4 +27,4 @@ cd "${SLURM_SUBMIT_DIR:-$(dirname "$0")/..}"
 # Build once beforehand (cargo build --release) so tasks do not race on target/.
 exec ./target/release/dibench reference "$scene" --spp "$spp" --seed "$seed" \
   --shard "${SLURM_ARRAY_TASK_ID}/${SLURM_ARRAY_TASK_COUNT}" \
-  ${SLURM_CPUS_PER_TASK:+--threads "$SLURM_CPUS_PER_TASK"} --out results
+  ${SLURM_CPUS_PER_TASK:+--threads "$SLURM_CPUS_PER_TASK"} --out "${DIBENCH_OUT:-results}"
