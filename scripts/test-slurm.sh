@@ -46,8 +46,9 @@ for tool in munged mungekey slurmctld slurmd sbatch sinfo scontrol scancel squeu
   command -v "$tool" >/dev/null 2>&1 || missing+=("$tool")
 done
 if [ ${#missing[@]} -gt 0 ]; then
-  die "missing ${missing[*]}: scripts/install-slurm.sh installs them (apt-get install slurmctld slurmd slurm-client munge; .ci/run calls it)"
+  die "missing ${missing[*]}: run scripts/install-slurm.sh first (apt-get install slurmctld slurmd slurm-client munge; .ci/run installs them that way)"
 fi
+[ "$(id -u)" -eq 0 ] || die "must run as root: slurmctld here runs as SlurmUser=root"
 bin=$repo/target/release/dibench
 [ -x "$bin" ] || die "$bin not found: build it first (cargo build --release); this test builds nothing"
 
