@@ -59,7 +59,7 @@ tmp=$(mktemp -d "${TMPDIR:-/tmp}/dibench-slurm.XXXXXX")
 chmod 711 "$tmp" # munged wants its socket's directories searchable by all
 pids=()          # daemons, in start order
 jobs_submitted=()
-array='' merge='' array2='' merge2='' # job ids, set by submit
+array='' merge='' array2='' merge2='' redo='' merge3='' # job ids, set by submit
 
 stop() {
   local rc=$?
@@ -320,6 +320,27 @@ if wait_until "$wait_s" finished "$array2" && wait_until "$wait_s" finished "$me
   fi
 else
   failed "array $array2 / merge $merge2 not finished within ${wait_s}s: $(states "$array2" | tr '\n' ' ') / $(states "$merge2")"
+fi
+
+# 3. Recovery: task 2 again alone (DIBENCH_SHARDS keeps it shard 2 of 4), then the merge; the
+# result is the first merge's, byte for byte (same shard films, merged in the same order).
+submit redo --array=2 --cpus-per-task=1 \
+  --export=ALL,DIBENCH_OUT="$fail_out",DIBENCH_SHARDS="$shards" \
+  --output="$tmp/jobs/redo-%A_%a.log" scripts/reference-slurm.sh "$scene" "$spp" "$seed"
+submit merge3 --dependency=afterok:"$redo" --kill-on-invalid-dep=yes --cpus-per-task=1 \
+  --output="$tmp/jobs/redo-merge-%j.log" \
+  --wrap="exec '$bin' merge '$scene' --out '$fail_out'"
+file_sums() { grep -h '"sha256"' "$@" 2>/dev/null; }
+if wait_until "$wait_s" finished "$merge3" && finished "$redo"; then
+  if [ "$(states "$redo")" = "2:COMPLETED:0:0" ] && [ "$(states "$merge3")" = ":COMPLETED:0:0" ] &&
+    [ -n "$(file_sums "$fail_out/$scene/reference/"*.json)" ] &&
+    [ "$(file_sums "$fail_out/$scene/reference/"*.json)" = "$(file_sums "$slurm_out/$scene/reference/"*.json)" ]; then
+    pass "task 2 redone alone (--array=2, DIBENCH_SHARDS=$shards) and merged: the first merge's files, byte for byte"
+  else
+    failed "redo: $(states "$redo") / merge $(states "$merge3"); $(cat "$tmp"/jobs/redo-*.log 2>/dev/null | tail -n 3)"
+  fi
+else
+  failed "redo $redo / merge $merge3 not finished within ${wait_s}s: $(states "$redo") / $(states "$merge3")"
 fi
 
 if [ "$failures" -eq 0 ]; then
