@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# Install what scripts/test-slurm.sh needs (slurmctld, slurmd, sbatch/sinfo/scontrol, munged)
-# from the distribution's packages with apt-get; a no-op when they are all present already.
+# Install what scripts/test-slurm.sh needs (slurmctld, slurmd, sbatch/sinfo/scontrol, munged,
+# and python3 for its EXR comparison) from the distribution's packages with apt-get; a no-op
+# when they are all present already.
 #
 #   scripts/install-slurm.sh            # as root (or with sudo on PATH)
 #
-# The lean package set below (no recommended plugins) is enough for a one-node cluster with
-# proctrack/linuxproc and task/none; `apt-get install slurm-wlm munge` works too but pulls in
-# about 40 packages. Exits non-zero when apt-get is unavailable or the install fails.
+# The lean package set below (8 packages on Debian bookworm, no recommended plugins) is enough
+# for a one-node cluster with proctrack/linuxproc and task/none; `apt-get install slurm-wlm
+# munge` works too but installs 42 (docs/cluster.md has the times). Exits non-zero when apt-get
+# is unavailable or the install fails.
 set -euo pipefail
 
 have() {
@@ -14,11 +16,13 @@ have() {
 }
 
 missing=()
-for tool in slurmctld slurmd sbatch sinfo scontrol munged; do
+for tool in slurmctld slurmd sbatch sinfo scontrol munged python3; do
   have "$tool" || missing+=("$tool")
 done
+packages=(slurmctld slurmd slurm-client munge)
+have python3 || packages+=(python3)
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "install-slurm: slurm and munge already installed"
+  echo "install-slurm: slurm, munge and python3 already installed"
   exit 0
 fi
 echo "install-slurm: missing ${missing[*]}; installing with apt-get"
@@ -38,8 +42,8 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update -q
 "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends \
-  slurmctld slurmd slurm-client munge
-for tool in slurmctld slurmd sbatch sinfo scontrol munged; do
+  "${packages[@]}"
+for tool in slurmctld slurmd sbatch sinfo scontrol munged python3; do
   if ! have "$tool"; then
     echo "install-slurm: $tool still missing after the install" >&2
     exit 1

@@ -242,6 +242,7 @@ else
 fi
 
 single_out=$tmp/out-single
+t_local=$SECONDS
 timeout "$wait_s" "$bin" reference "$scene" --spp "$spp" --seed "$seed" --out "$single_out" \
   >"$tmp/log/single.log" 2>&1 || die "single-process reference failed: $(tail -n 5 "$tmp/log/single.log")"
 local_out=$tmp/out-local
@@ -250,6 +251,7 @@ for ((i = 0; i < shards; i++)); do
     --out "$local_out" >>"$tmp/log/local.log" 2>&1 || die "local shard $i/$shards failed: $(tail -n 5 "$tmp/log/local.log")"
 done
 
+echo "rendered the single-process reference and $shards local shards in $((SECONDS - t_local)) s"
 mapfile -t singles < <(references_in "$single_out")
 [ ${#singles[@]} -gt 0 ] || die "the single-process reference wrote no manifest under $single_out"
 for ref in "${singles[@]}"; do
@@ -344,7 +346,7 @@ else
 fi
 
 if [ "$failures" -eq 0 ]; then
-  echo "PASS: test-slurm ($((SECONDS - start)) s with the cluster up)"
+  echo "PASS: test-slurm ($((SECONDS - start)) s from starting munged)"
 else
   echo "FAIL: test-slurm: $failures check(s) failed"
   exit 1
