@@ -83,7 +83,7 @@ stop() {
     wait "$pid" 2>/dev/null
   done
   if [ "$rc" -ne 0 ] && [ -d "$tmp/log" ]; then
-    for f in "$tmp"/log/*; do
+    for f in "$tmp"/log/* "$tmp"/jobs/*; do
       [ -f "$f" ] || continue
       echo "--- last lines of $f"
       tail -n 15 "$f"
@@ -244,11 +244,11 @@ fi
 single_out=$tmp/out-single
 t_local=$SECONDS
 timeout "$wait_s" "$bin" reference "$scene" --spp "$spp" --seed "$seed" --out "$single_out" \
-  >"$tmp/log/single.log" 2>&1 || die "single-process reference failed: $(tail -n 5 "$tmp/log/single.log")"
+  >"$tmp/log/single.log" 2>&1 || die "single-process reference failed (exit $?, 124 if past ${wait_s}s): $(tail -n 5 "$tmp/log/single.log")"
 local_out=$tmp/out-local
 for ((i = 0; i < shards; i++)); do
   timeout "$wait_s" "$bin" reference "$scene" --spp "$spp" --seed "$seed" --shard "$i/$shards" \
-    --out "$local_out" >>"$tmp/log/local.log" 2>&1 || die "local shard $i/$shards failed: $(tail -n 5 "$tmp/log/local.log")"
+    --out "$local_out" >>"$tmp/log/local.log" 2>&1 || die "local shard $i/$shards failed (exit $?, 124 if past ${wait_s}s): $(tail -n 5 "$tmp/log/local.log")"
 done
 
 echo "rendered the single-process reference and $shards local shards in $((SECONDS - t_local)) s"
