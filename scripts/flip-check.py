@@ -43,7 +43,7 @@ def read_raw(path, channels):
     with open(path, "rb") as f:
         data = f.read()
     w, h = np.frombuffer(data[:8], dtype="<u4")
-    return np.frombuffer(data[8:], dtype="<f4").reshape(h, w, channels)
+    return np.frombuffer(data[8:], dtype="<f4").reshape(h, w, channels).astype(np.float32)  # a writable copy
 
 
 def srgb_encode(lin):
@@ -210,7 +210,8 @@ def main():
     cases.append(("median-0 reference", *mostly_black_pair(rng), None))
     with tempfile.TemporaryDirectory() as tmp:
         for r, t in args.exr:
-            cases.append((f"render {os.path.basename(t)}", read_exr(binary, tmp, r), read_exr(binary, tmp, t), None))
+            label = os.path.basename(os.path.dirname(os.path.dirname(os.path.abspath(t))))  # results/<scene>/...
+            cases.append((f"render {label}", read_exr(binary, tmp, r), read_exr(binary, tmp, t), None))
 
         failed = False
         print(f"{'case':28} {'mode':4} {'size':>8} {'ref mean':>12} {'dibench mean':>12} "
