@@ -12,6 +12,7 @@ pub mod closed_form;
 pub mod env;
 pub mod error;
 pub mod film;
+pub mod flip;
 pub mod geometry;
 pub mod harness;
 pub mod interrupt;
