@@ -81,7 +81,20 @@ impl FlipMap {
     pub fn get(&self, x: usize, y: usize) -> f32 {
         self.values[y * self.width + x]
     }
+
+    /// The map as an image, the value in all three channels (an error map EXR viewers show
+    /// in grey, `<stem>.flip.exr`).
+    pub fn to_image(&self) -> Image {
+        Image {
+            width: self.width as u32,
+            height: self.height as u32,
+            pixels: self.values.iter().map(|&v| [v as f64; 3]).collect(),
+        }
+    }
 }
+
+/// What a FLIP map's EXR holds (`Provenance::content`).
+pub const CONTENT: &str = "HDR-FLIP error";
 
 /// HDR-FLIP's exposures, in stops (the image is multiplied by 2^exposure).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -201,7 +201,7 @@ fn cli_compare_writes_exrs_and_csv() {
     let header = csv.lines().next().unwrap();
     assert_eq!(
         header,
-        "scene,strategy,integrand,backend,threads,run,seed,checkpoint,time_s,spp,rmse,relmse,sampler"
+        "scene,strategy,integrand,backend,threads,run,seed,checkpoint,time_s,spp,rmse,relmse,sampler,flip"
     );
     for s in ["light", "cosine", "mis-power"] {
         assert!(

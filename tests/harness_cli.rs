@@ -97,7 +97,7 @@ fn compare_runs_writes_summary_variance_metadata_and_plots() {
          rmse_ci95,rmse_debiased,mse_debiased_mean,mse_debiased_ci95,relmse_mean,relmse_ci95,\
          relmse_debiased_mean,relmse_debiased_ci95,efficiency,predicted_rmse,\
          reference_noise_floor,slope_time_mean,slope_time_ci95,slope_spp_mean,welch_p_vs_best,\
-         holm_p_vs_best,vs_best,sampler,budget_spp"
+         holm_p_vs_best,vs_best,sampler,budget_spp,flip_mean,flip_ci95"
     );
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), 3, "{summary}");
@@ -614,13 +614,19 @@ fn compare_with_two_samplers() {
     let runs = run_dirs(&dir.path().join("out/tiny"));
     let run_dir = &runs[0];
     let results = std::fs::read_to_string(run_dir.join("results.csv")).unwrap();
-    assert!(results.lines().next().unwrap().ends_with(",relmse,sampler"));
+    assert!(
+        results
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",relmse,sampler,flip")
+    );
     for s in ["light", "cosine"] {
         for g in ["independent", "sobol"] {
             assert!(
                 results
                     .lines()
-                    .any(|l| l.contains(&format!(",{s},")) && l.ends_with(&format!(",{g}"))),
+                    .any(|l| l.contains(&format!(",{s},")) && l.split(",").nth(12) == Some(g)),
                 "no {s} × {g} rows:\n{results}"
             );
         }
@@ -792,6 +798,52 @@ fn compare_at_equal_spp() {
     assert_eq!(
         (r.spp, r.sampler.as_str(), r.scene_hash),
         (64, "independent", p.scene_hash)
+    );
+    // FLIP: the final row of each run has it, the earlier ones not; run 0's value is the
+    // HDR-FLIP of the EXRs on disk (recomputed here), whose map is <stem>.flip.exr.
+    let results = std::fs::read_to_string(run_dir.join("results.csv")).unwrap();
+    let mut lines = results.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    for r in &rows {
+        assert_eq!(
+            r[col("flip")].is_empty(),
+            r[col("checkpoint")] != "7",
+            "{results}"
+        );
+    }
+    let final_flip: f64 = rows
+        .iter()
+        .find(|r| {
+            r[col("strategy")] == "light"
+                && r[col("sampler")] == "stratified"
+                && r[col("run")] == "0"
+                && r[col("checkpoint")] == "7"
+        })
+        .unwrap()[col("flip")]
+    .parse()
+    .unwrap();
+    let image = dibench::output::read_exr(&run_dir.join("light.stratified.exr")).unwrap();
+    let reference_image = dibench::output::read_exr(&reference).unwrap();
+    let flip = dibench::flip::hdr_flip_image(&reference_image, &image).unwrap();
+    assert_eq!(flip.mean(), final_flip);
+    assert!(final_flip > 0.0 && final_flip < 1.0, "{final_flip}");
+    let map = dibench::output::read_exr(&run_dir.join("light.stratified.flip.exr")).unwrap();
+    assert_eq!(map, flip.to_image());
+    let fp = dibench::output::read_provenance(&run_dir.join("light.stratified.flip.exr"))
+        .unwrap()
+        .unwrap();
+    assert_eq!(fp.content, dibench::flip::CONTENT);
+    let summary = std::fs::read_to_string(run_dir.join("summary.csv")).unwrap();
+    assert!(
+        summary.lines().skip(1).all(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            f[f.len() - 2]
+                .parse::<f64>()
+                .is_ok_and(|m| m > 0.0 && m < 1.0)
+        }),
+        "flip_mean: {summary}"
     );
     // The spp chart: x in samples per pixel, one curve per pair with its slope.
     let (code, _, stderr) = dibench(&["plot", run_dir.to_str().unwrap()], dir.path());

@@ -134,6 +134,11 @@ pub struct ResultRow {
     /// positions; a results.csv written before the column existed reads as `independent`.
     #[serde(default = "default_sampler")]
     pub sampler: String,
+    /// Mean HDR-FLIP against the reference (`crate::flip`, Andersson et al. 2020/2021) of the
+    /// final (equal-budget) image; empty at the earlier checkpoints, where it is not computed
+    /// (it costs about as much as a few passes).
+    #[serde(default)]
+    pub flip: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -176,6 +181,8 @@ struct RunMeta<'a> {
 pub struct StrategyRun {
     pub image: Image,
     pub variance: Image,
+    /// The final image's per-pixel HDR-FLIP against the reference.
+    pub flip: crate::flip::FlipMap,
     pub rows: Vec<ResultRow>,
     /// None for a generator whose samples are not independent (the across-pass variance is
     /// then not the per-sample variance the prediction needs).
@@ -238,6 +245,7 @@ pub fn run_strategy(
             spp: film.spp,
             rmse: rmse(&image, reference),
             relmse: relmse(&image, reference),
+            flip: None,
         }
     };
     loop {
@@ -266,10 +274,16 @@ pub fn run_strategy(
             }
         }
     }
-    // The last row is always the final image at the (bounded) budget.
-    rows.push(row(&film, CHECKPOINTS - 1, elapsed));
+    // The last row is always the final image at the (bounded) budget, with its FLIP.
+    let image = film.mean();
+    let flip = crate::flip::hdr_flip_image(reference, &image)?;
+    rows.push(ResultRow {
+        flip: Some(flip.mean()),
+        ..row(&film, CHECKPOINTS - 1, elapsed)
+    });
     Ok(StrategyRun {
-        image: film.mean(),
+        flip,
+        image,
         variance: film.variance_of_mean(),
         rows,
         mean_sample_variance: generator
@@ -679,6 +693,14 @@ pub fn run(
                         &provenance.variance(),
                     )?;
                 }
+                write_exr_with(
+                    &dir.join(format!("{stem}.flip.exr")),
+                    &r.flip.to_image(),
+                    &Provenance {
+                        content: crate::flip::CONTENT.into(),
+                        ..provenance
+                    },
+                )?;
             }
             let Some(last) = FinalRun::new(
                 &r.rows,

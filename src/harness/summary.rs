@@ -133,6 +133,10 @@ pub struct SummaryRow {
     pub sampler: String,
     /// The sample budget per run (`--spp`); empty at equal time (`budget_s`).
     pub budget_spp: Option<u64>,
+    /// Mean HDR-FLIP of the final image against the reference (`crate::flip`), mean over runs,
+    /// with its 95 % interval; empty for runs recorded without it.
+    pub flip_mean: Option<f64>,
+    pub flip_ci95: Option<f64>,
 }
 
 /// A summary key: (integrand, strategy, sampler).
@@ -171,6 +175,8 @@ pub fn summarize(finals: &[FinalRun], budget: Budget) -> Vec<SummaryRow> {
             let slopes_t: Vec<f64> = g.iter().filter_map(|f| f.slope_time).collect();
             let slopes_n: Vec<f64> = g.iter().filter_map(|f| f.slope_spp).collect();
             let slope_t = (!slopes_t.is_empty()).then(|| mean_ci(&slopes_t, LEVEL));
+            let flips: Option<Vec<f64>> = g.iter().map(|f| f.row.flip).collect();
+            let flip = flips.map(|v| mean_ci(&v, LEVEL));
             let floor = g[0].reference_noise_floor;
             // Only when every run has an independent-sample variance.
             let predicted: Option<Vec<f64>> = g
@@ -190,6 +196,8 @@ pub fn summarize(finals: &[FinalRun], budget: Budget) -> Vec<SummaryRow> {
                 runs: g.len(),
                 budget_s: budget.seconds(),
                 budget_spp: budget.spp(),
+                flip_mean: flip.as_ref().map(|m| m.mean),
+                flip_ci95: flip.and_then(|m| m.half_width),
                 time_s_mean: time.mean,
                 overshoot_max: budget
                     .seconds()
@@ -351,6 +359,7 @@ mod tests {
                 spp: 100,
                 rmse: relmse.sqrt(),
                 relmse,
+                flip: Some(0.1),
             },
             mean_sample_variance: Some(0.01),
             reference_noise_floor: Some(0.001),
