@@ -302,7 +302,8 @@ pub fn check_run_dir(dir: &Path, settled: bool) -> Result<serde_json::Value, Str
             .map_err(|e| format!("{shown}/results.csv: {e}"))?;
         for r in reader.records() {
             let r = r.map_err(|e| format!("{shown}/results.csv: {e}"))?;
-            if r.len() != 13 {
+            // 14 columns, `flip` last (13 before it existed).
+            if r.len() != 14 && r.len() != 13 {
                 return Err(format!("{shown}/results.csv: a row of {} fields", r.len()));
             }
             if &r[7] == "7" {
@@ -324,9 +325,9 @@ pub fn check_run_dir(dir: &Path, settled: bool) -> Result<serde_json::Value, Str
             let stem = dibench::harness::compare::image_stem(s, g);
             // A non-independent sampler writes no variance image (docs/samplers.md).
             let suffixes: &[&str] = if g == "independent" {
-                &["", ".variance"]
+                &["", ".variance", ".flip"]
             } else {
-                &[""]
+                &["", ".flip"]
             };
             for suffix in suffixes {
                 let exr = dir.join(format!("{stem}{suffix}.exr"));
