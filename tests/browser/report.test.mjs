@@ -85,8 +85,8 @@ try {
   await page.waitForFunction(() => window.dibenchReport && window.dibenchReport.ready, null, { timeout: 30000 });
   console.log(`page ready in ${Date.now() - t0} ms (${(fs.statSync(report).size / 1048576).toFixed(2)} MiB)`);
   const R = (fn, ...a) => page.evaluate(fn, ...a);
-  // The sticky navigation bar would cover the top of element screenshots.
-  await page.addStyleTag({ content: 'nav#toc { position: static !important; }' });
+  // Sticky elements (the navigation bar, the viewer's sidebar) would shift in element screenshots.
+  await page.addStyleTag({ content: 'nav#toc, .sidebar { position: static !important; }' });
 
   // Every strategy's image and every reference decoded, with finite values.
   const names = await R(() => window.dibenchReport.images);
@@ -244,8 +244,10 @@ try {
   check(verdicts === summary.length, 'every row has a styled vs_best verdict');
   await th.click();
   if (shots !== 'none') {
-    await page.addStyleTag({ content: '.table-wrap { overflow: visible !important; }' });
-    await page.locator('#summary-table').screenshot({ path: path.join(shots, 'report-table.png') });
+    // Wide enough for the main columns without scrolling.
+    await page.setViewportSize({ width: 1800, height: 1000 });
+    await page.locator('#summary .table-wrap').screenshot({ path: path.join(shots, 'report-table.png') });
+    await page.setViewportSize({ width: 1400, height: 1000 });
     await page.locator('#convergence').screenshot({ path: path.join(shots, 'report-convergence.png') });
   }
   const lines = await page.locator('#plot svg .series').count();
@@ -256,10 +258,28 @@ try {
   await page.keyboard.press('e');
   check(await R(() => window.dibenchReport.mode()) === 'relmse', 'key e shows the relMSE map');
   check(await page.locator('#legend .colourbar').count() === 1, 'with a colour bar');
+  // FLIP: a strategy with <stem>.flip.exr shows it (scripts/test-browser.sh writes a
+  // stand-in, min(1, √relMSE), for one), one without says so.
+  const withFlip = stems.filter((s) => fs.existsSync(path.join(runDir, `${s}.flip.exr`)));
+  const withoutFlip = stems.filter((s) => !withFlip.includes(s));
   await page.keyboard.press('p');
-  const flipMsg = await page.locator('#view-message').innerText();
-  const hasFlip = fs.existsSync(path.join(runDir, `${stems[0]}.flip.exr`));
-  check(hasFlip ? flipMsg === '' : flipMsg.includes('no FLIP map'), `FLIP mode: "${flipMsg || 'map shown'}"`);
+  if (withoutFlip.length) {
+    await R((n) => window.dibenchReport.select(n), withoutFlip[0]);
+    const msg = await page.locator('#view-message').innerText();
+    check(msg.includes('no FLIP map'), `FLIP mode without a map: "${msg}"`);
+  }
+  for (const stem of withFlip) {
+    await R((n) => window.dibenchReport.select(n), stem);
+    const msg = await page.locator('#view-message').innerText();
+    check(msg === '' && await page.locator('#legend .colourbar').count() === 1, `FLIP mode shows ${stem}.flip.exr with its colour bar`);
+    const [x, y] = probes[2];
+    const [i0, i1, i2] = exrF32('pixel', path.join(runDir, `${stem}.exr`), x, y);
+    const [r0, r1, r2] = exrF32('pixel', refFile(integrandOf[stem]), x, y);
+    const rel = ([[i0, r0], [i1, r1], [i2, r2]].reduce((s, [i, r]) => s + ((i - r) ** 2) / (r * r + 0.01), 0)) / 3;
+    const got = await R(([n, x, y]) => window.dibenchReport.mapValue(n, 'flip', x, y), [stem, x, y]);
+    check(close(got, Math.min(1, Math.sqrt(rel)), 1e-6), `${stem}: FLIP map at (${x}, ${y}) = the stand-in's ${got}`);
+  }
+  await page.keyboard.press('1');
   await page.keyboard.press('e');
   const cells = await page.locator('#errormap-grid [data-mode]').count();
   check(cells === 3 * stems.length, `error map grid: ${cells} cells for ${stems.length} strategies`);
