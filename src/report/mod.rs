@@ -109,7 +109,8 @@ pub struct Pixels {
 struct Budget {
     used: u64,
     limit: u64,
-    width: Option<(usize, usize)>,
+    /// The run's image size: run.json's, else the first file's.
+    size: Option<(usize, usize)>,
 }
 
 impl Budget {
@@ -131,7 +132,7 @@ impl Budget {
             });
         };
         let size = (h.layer_size.width(), h.layer_size.height());
-        match self.width {
+        match self.size {
             Some(want) if want != size => {
                 return Err(Error::Parse {
                     path: path.into(),
@@ -141,7 +142,7 @@ impl Budget {
                     ),
                 });
             }
-            _ => self.width = Some(size),
+            _ => self.size = Some(size),
         }
         let need = crate::bounded::bytes(size.0 as u64 * size.1 as u64, 4 * channels);
         let total = self.used.saturating_add(need);
@@ -170,7 +171,7 @@ impl Budget {
     /// Checks `px`, decoded from `path`, against the size its header gave (a file with several
     /// layers may decode another one).
     fn decoded(&self, px: Pixels, path: &Path) -> Result<Pixels> {
-        match self.width {
+        match self.size {
             Some(want) if want != (px.width, px.height) => Err(Error::Parse {
                 path: path.into(),
                 message: format!(
@@ -412,7 +413,7 @@ fn build(run_dir: &Path, limit: u64) -> Result<String> {
     let mut budget = Budget {
         used: 0,
         limit,
-        width: size,
+        size,
     };
     let mut blocks = Blocks(Vec::new());
     let mut images: Vec<Value> = Vec::new();
@@ -518,7 +519,7 @@ fn build(run_dir: &Path, limit: u64) -> Result<String> {
             "flip": flip,
         }));
     }
-    let (width, height) = budget.width.unwrap_or((0, 0));
+    let (width, height) = budget.size.unwrap_or((0, 0));
 
     let run_id = run_dir
         .canonicalize()

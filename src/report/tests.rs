@@ -440,3 +440,22 @@ fn a_replaced_reference_is_noted() {
         "{notes}"
     );
 }
+
+/// Every file the page needs is named when it is missing: results.csv, a strategy's image.
+#[test]
+fn a_missing_results_csv_or_image_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = run_dir(dir.path(), 4, 3);
+    std::fs::remove_file(run.join("bsdf.exr")).unwrap();
+    let msg = err(&run);
+    assert!(msg.contains("bsdf.exr"), "{msg}");
+    std::fs::remove_file(run.join("results.csv")).unwrap();
+    let msg = err(&run);
+    assert!(msg.contains("results.csv"), "{msg}");
+    // A variance or FLIP file is optional: without them the page still builds.
+    let run = run_dir(&dir.path().join("b"), 4, 3);
+    std::fs::remove_file(run.join("light.variance.exr")).unwrap();
+    let (data, _) = parse_page(&build_report(&run).unwrap());
+    assert!(data["images"][1]["variance"].is_null());
+    assert!(data["images"][2]["variance"].is_string());
+}
