@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# The browser test of report.html: makes a small compare run of cornell in a temporary
-# output root, writes its report with `dibench report`, and drives the page in headless
-# Chromium (tests/browser/report.test.mjs; playwright-core from tests/browser's lock file).
+# The browser test of report.html: makes two small compare runs of cornell in a temporary
+# output root (every strategy; then two with the sobol sampler beside the independent one),
+# writes their reports with `dibench report`, and drives each page in headless Chromium (tests/browser/report.test.mjs; playwright-core from tests/browser's lock file).
 # Builds nothing: expects target/release/dibench and target/release/examples/exr_pixel
 # (cargo build --release --bins --example exr_pixel). Needs node (18 or later), npm and
 # /usr/bin/chromium (scripts/install-browser.sh). Screenshots go to docs/figures/report-*.png
@@ -38,4 +38,14 @@ target/release/examples/exr_pixel standin-flip "$run_dir/mis-power.exr" "$refere
 target/release/dibench report "$run_dir"
 (cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
 EXR_PIXEL="$PWD/target/release/examples/exr_pixel" node tests/browser/report.test.mjs "$run_dir"
+# A second run with a non-independent sampler too: images named <strategy>.<sampler>, some
+# without a variance map (no screenshots from this one).
+target/release/dibench compare cornell --time 0.1 --runs 2 --reference-spp 64 --out "$out" \
+    --strategies light,mis-power --sampler independent,sobol >"$out/compare2.log" 2>&1 ||
+    { cat "$out/compare2.log" >&2; fail "dibench compare --sampler independent,sobol failed"; }
+run_dir2=$(find "$out/cornell" -mindepth 1 -maxdepth 1 -type d ! -name reference ! -path "$run_dir" | head -n 1)
+[ -n "$run_dir2" ] || fail "the second compare wrote no run directory under $out/cornell"
+target/release/dibench report "$run_dir2"
+SCREENSHOTS=none EXR_PIXEL="$PWD/target/release/examples/exr_pixel" \
+    node tests/browser/report.test.mjs "$run_dir2"
 echo "test-browser: passed in $(($(date +%s) - start)) s"
