@@ -25,6 +25,7 @@ pub mod plugin;
 pub mod prelude;
 pub mod prepare;
 pub mod render;
+pub mod report;
 pub mod sampling;
 pub mod scene;
 pub mod simd;

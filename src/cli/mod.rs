@@ -17,6 +17,7 @@ pub mod merge;
 pub mod plot;
 pub mod rays;
 pub mod reference;
+pub mod report;
 pub mod strategies;
 pub mod stress;
 pub mod warp;
@@ -27,6 +28,7 @@ pub use merge::MergeArgs;
 pub use plot::PlotArgs;
 pub use rays::RaysArgs;
 pub use reference::ReferenceArgs;
+pub use report::ReportArgs;
 pub use strategies::StrategiesArgs;
 pub use stress::StressArgs;
 pub use warp::WarpArgs;
@@ -63,6 +65,10 @@ pub enum Command {
     /// Figures of a compare run: RMSE against time with CI bands, variance heatmaps, image
     /// strip; PNG (and SVG for the chart) in RUN_DIR/plots/.
     Plot(PlotArgs),
+    /// A self-contained HTML page of a compare run (RUN_DIR/report.html, no network needed):
+    /// sortable summary, convergence plot, flip-book viewer with exposure, zoom and pixel
+    /// readout, error maps, region statistics.
+    Report(ReportArgs),
     /// Merge the shards written by `reference --shard i/n` into the scene's reference files.
     Merge(MergeArgs),
 }
@@ -304,5 +310,6 @@ pub fn run_with(cli: Cli, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
         Command::Stress(a) => stress::run(a),
         Command::Merge(a) => merge::run(a),
         Command::Plot(a) => plot::run(a),
+        Command::Report(a) => report::run(a),
     }
 }

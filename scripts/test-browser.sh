@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The browser test of report.html: makes two small compare runs of cornell in a temporary
+# output root (every strategy; then two with the sobol sampler beside the independent one),
+# writes their reports with `dibench report`, and drives each page in headless Chromium (tests/browser/report.test.mjs; playwright-core from tests/browser's lock file).
+# Builds nothing: expects target/release/dibench and target/release/examples/exr_pixel
+# (cargo build --release --bins --example exr_pixel). Needs node (18 or later), npm and
+# /usr/bin/chromium (scripts/install-browser.sh). Screenshots go to docs/figures/report-*.png
+# (SCREENSHOTS=none to skip, or another folder).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+fail() {
+    echo "test-browser: $*" >&2
+    exit 1
+}
+[ -x target/release/dibench ] || fail "target/release/dibench is missing: cargo build --release"
+[ -x target/release/examples/exr_pixel ] ||
+    fail "target/release/examples/exr_pixel is missing: cargo build --release --example exr_pixel"
+command -v node >/dev/null || fail "node is not installed (node 18 or later is needed)"
+command -v npm >/dev/null || fail "npm is not installed"
+[ -x "${CHROMIUM:-/usr/bin/chromium}" ] ||
+    fail "${CHROMIUM:-/usr/bin/chromium} is missing: run scripts/install-browser.sh"
+node_major=$(node -p 'process.versions.node.split(".")[0]')
+[ "$node_major" -ge 18 ] || fail "node $(node --version) is too old (18 or later)"
+
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+start=$(date +%s)
+# A small run: 2 runs of 0.2 s per strategy against a 64-spp reference.
+target/release/dibench compare cornell --time 0.2 --runs 2 --reference-spp 64 --out "$out" \
+    >"$out/compare.log" 2>&1 || { cat "$out/compare.log" >&2; fail "dibench compare failed"; }
+run_dir=$(find "$out/cornell" -mindepth 1 -maxdepth 1 -type d ! -name reference | head -n 1)
+[ -n "$run_dir" ] || fail "compare wrote no run directory under $out/cornell"
+# A stand-in FLIP map for one strategy (min(1, √relMSE), not FLIP: see examples/exr_pixel.rs),
+# so that the page's FLIP display is exercised too.
+reference=$(node -e 'const p = require("path"); const m = require(process.argv[1]);
+    console.log(p.join(p.dirname(process.argv[1]), m.files.image.name))' "$out/cornell/reference/direct.json")
+target/release/examples/exr_pixel standin-flip "$run_dir/mis-power.exr" "$reference" "$run_dir/mis-power.flip.exr"
+target/release/dibench report "$run_dir"
+(cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
+EXR_PIXEL="$PWD/target/release/examples/exr_pixel" node tests/browser/report.test.mjs "$run_dir"
+# A second run with a non-independent sampler too: images named <strategy>.<sampler>, some
+# without a variance map (no screenshots from this one).
+target/release/dibench compare cornell --time 0.1 --runs 2 --reference-spp 64 --out "$out" \
+    --strategies light,mis-power --sampler independent,sobol >"$out/compare2.log" 2>&1 ||
+    { cat "$out/compare2.log" >&2; fail "dibench compare --sampler independent,sobol failed"; }
+run_dir2=$(find "$out/cornell" -mindepth 1 -maxdepth 1 -type d ! -name reference ! -path "$run_dir" | head -n 1)
+[ -n "$run_dir2" ] || fail "the second compare wrote no run directory under $out/cornell"
+target/release/dibench report "$run_dir2"
+SCREENSHOTS=none EXR_PIXEL="$PWD/target/release/examples/exr_pixel" \
+    node tests/browser/report.test.mjs "$run_dir2"
+echo "test-browser: passed in $(($(date +%s) - start)) s"
