@@ -4,12 +4,7 @@
 //! exr_pixel pixel FILE.exr X Y                   → "R G B" of pixel (X, Y), from the top left
 //! exr_pixel region IMAGE.exr REF.exr X0 Y0 X1 Y1 → "RMSE relMSE" of IMAGE against REF over
 //!                                                  the pixels [X0, X1) × [Y0, Y1)
-//! exr_pixel standin-flip IMAGE.exr REF.exr OUT.exr → writes a one-channel (`Y`) stand-in for
-//!                                                  a FLIP map: min(1, √relMSE) per pixel
 //! ```
-//!
-//! The stand-in is not FLIP: it lets the browser test exercise the page's FLIP display (one
-//! channel, values in [0, 1]) before dibench computes FLIP itself.
 //!
 //! Values are printed in full (f32 values exactly, metrics to 17 significant digits); the
 //! metrics are `dibench::metrics`' own, on the region cut out of both images.
@@ -79,32 +74,9 @@ fn main() -> Result<(), String> {
             );
             Ok(())
         }
-        ["standin-flip", image, reference, out] => {
-            let (img, reference) = (load(image)?, load(reference)?);
-            if (img.width, img.height) != (reference.width, reference.height) {
-                return Err("the image and the reference differ in size".into());
-            }
-            let w = img.width as usize;
-            let value = |x: usize, y: usize| {
-                let (a, b) = (img.pixels[y * w + x], reference.pixels[y * w + x]);
-                let rel = (0..3)
-                    .map(|c| (a[c] - b[c]).powi(2) / (b[c] * b[c] + dibench::metrics::EPS))
-                    .sum::<f64>()
-                    / 3.0;
-                rel.sqrt().min(1.0) as f32
-            };
-            use exr::prelude::*;
-            let channels = SpecificChannels::build()
-                .with_channel("Y")
-                .with_pixel_fn(|Vec2(x, y)| (value(x, y),));
-            Image::from_channels((w, img.height as usize), channels)
-                .write()
-                .to_file(out)
-                .map_err(|e| format!("cannot write {out}: {e}"))
-        }
         _ => Err(
             "usage: exr_pixel pixel FILE.exr X Y | exr_pixel region IMAGE.exr REF.exr \
-                  X0 Y0 X1 Y1 | exr_pixel standin-flip IMAGE.exr REF.exr OUT.exr"
+                  X0 Y0 X1 Y1"
                 .into(),
         ),
     }

@@ -307,6 +307,8 @@ pub struct CompareReport {
     pub references: Vec<ReferenceUsed>,
     /// Whether a non-independent generator ran (then [`QMC_NOTE`] is printed).
     pub qmc: bool,
+    /// `report.html`, when it could be written.
+    pub report_html: Option<PathBuf>,
 }
 
 /// A reference a compare run measured against.
@@ -361,6 +363,9 @@ impl std::fmt::Display for CompareReport {
             writeln!(f, "note: {QMC_NOTE}")?;
         }
         writeln!(f, "results: {}", self.run_dir.display())?;
+        if let Some(html) = &self.report_html {
+            writeln!(f, "report: {}", html.display())?;
+        }
         // The table last, ranked by the debiased relMSE (see `summary`).
         let ci = |x: Option<f64>| x.map_or("-".to_string(), |h| format!("{h:.2e}"));
         let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2}"));
@@ -722,6 +727,15 @@ pub fn run(
     let summary = summarize(&finals, opts.budget);
     write_csv(&dir.join("summary.csv"), &summary)?;
     run_dir.record(&meta, Status::Complete)?;
+    // The page over everything the run wrote. A run whose images are too large to embed is
+    // still a complete run: it says why there is no page (`dibench report` says the same).
+    let report_html = match crate::report::write_report(dir) {
+        Ok(path) => Some(path),
+        Err(e) => {
+            crate::interrupt::note(&format!("report.html not written: {e}"));
+            None
+        }
+    };
     Ok(CompareReport {
         run_dir: dir.to_path_buf(),
         rows,
@@ -742,5 +756,6 @@ pub fn run(
             })
             .collect(),
         qmc,
+        report_html,
     })
 }
