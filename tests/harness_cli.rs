@@ -2,42 +2,10 @@
 //! metadata, reference noise floor and checkpoints, plots, and errors for bad arguments.
 
 mod common;
-use common::{dibench, stored_file};
+use common::{TINY_WITH_AO as SCENE, dibench, stored_file};
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-/// A quad light over a floor with a sphere: light and direction strategies both apply, and
-/// an [ambient_occlusion] section adds the AO integrand.
-const SCENE: &str = r#"
-[camera]
-eye = [0.0, 1.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-[image]
-width = 16
-height = 12
-[[material]]
-name = "m"
-albedo = [0.5, 0.5, 0.5]
-[[quad]]
-corner = [-3.0, 0.0, -3.0]
-edge_u = [0.0, 0.0, 6.0]
-edge_v = [6.0, 0.0, 0.0]
-material = "m"
-[[quad]]
-corner = [-0.5, 1.5, -0.5]
-edge_u = [1.0, 0.0, 0.0]
-edge_v = [0.0, 0.0, 1.0]
-material = "m"
-emission = [4.0, 4.0, 4.0]
-[[sphere]]
-center = [0.3, 0.3, 0.0]
-radius = 0.3
-material = "m"
-[ambient_occlusion]
-distance = 0.5
-"#;
 
 fn run_dirs(scene_dir: &Path) -> Vec<PathBuf> {
     std::fs::read_dir(scene_dir)

@@ -3,40 +3,9 @@
 //! naming what is wrong, with exit status 1 and no panic.
 
 mod common;
-use common::dibench;
+use common::{TINY_WITH_AO as SCENE, dibench};
 
 use std::path::{Path, PathBuf};
-
-/// A quad light over a floor with a sphere, and ambient occlusion (a second integrand).
-const SCENE: &str = r#"
-[camera]
-eye = [0.0, 1.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-[image]
-width = 16
-height = 12
-[[material]]
-name = "m"
-albedo = [0.5, 0.5, 0.5]
-[[quad]]
-corner = [-3.0, 0.0, -3.0]
-edge_u = [0.0, 0.0, 6.0]
-edge_v = [6.0, 0.0, 0.0]
-material = "m"
-[[quad]]
-corner = [-0.5, 1.5, -0.5]
-edge_u = [1.0, 0.0, 0.0]
-edge_v = [0.0, 0.0, 1.0]
-material = "m"
-emission = [4.0, 4.0, 4.0]
-[[sphere]]
-center = [0.3, 0.3, 0.0]
-radius = 0.3
-material = "m"
-[ambient_occlusion]
-distance = 0.5
-"#;
 
 fn compare(dir: &Path) -> PathBuf {
     std::fs::write(dir.join("tiny.toml"), SCENE).unwrap();
@@ -72,6 +41,9 @@ fn compare(dir: &Path) -> PathBuf {
 fn report_writes_one_page_with_every_image_and_both_references() {
     let dir = tempfile::tempdir().unwrap();
     let run = compare(dir.path());
+    // compare wrote the page; the subcommand writes it anew.
+    let by_compare = std::fs::read_to_string(run.join("report.html")).unwrap();
+    std::fs::remove_file(run.join("report.html")).unwrap();
     let (code, stdout, stderr) = dibench(&["report", run.to_str().unwrap()], dir.path());
     assert_eq!(code, 0, "{stderr}");
     assert!(stdout.trim().ends_with("report.html"), "{stdout}");
@@ -95,8 +67,16 @@ fn report_writes_one_page_with_every_image_and_both_references() {
     ] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
     }
-    // One pixel block per image, variance and reference: 3 strategies × 2 + 2 references.
-    assert_eq!(html.matches("type=\"application/octet-stream\"").count(), 8);
+    assert_eq!(
+        html, by_compare,
+        "the subcommand's page differs from compare's"
+    );
+    // One pixel block per image, variance, FLIP map and reference: 3 strategies × 3 + 2
+    // references.
+    assert_eq!(
+        html.matches("type=\"application/octet-stream\"").count(),
+        11
+    );
     // Self-contained: no URL the browser would fetch.
     for needle in ["http://", "https://", "src=\"", "href=\"http"] {
         let hits: Vec<usize> = html.match_indices(needle).map(|(i, _)| i).collect();
@@ -118,6 +98,7 @@ fn bad_run_directories_are_errors_naming_the_problem() {
     assert_eq!(code, 1);
     assert!(stderr.contains("run.json"), "{stderr}");
     let run = compare(dir.path());
+    std::fs::remove_file(run.join("report.html")).unwrap();
     std::fs::write(run.join("summary.csv"), "garbage\n").unwrap();
     let (code, _, stderr) = dibench(&["report", run.to_str().unwrap()], dir.path());
     assert_eq!(code, 1);

@@ -480,7 +480,12 @@ fn build(run_dir: &Path, limit: u64) -> Result<String> {
             "name": name,
             "kind": "reference",
             "integrand": integrand,
-            "file": path.display().to_string(),
+            // Relative to the run directory, so the page does not depend on how its
+            // directory was named on the command line.
+            "file": format!(
+                "../reference/{}",
+                path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned())
+            ),
             "spp": spp,
             "pixels": blocks.add(&px),
         }));
@@ -513,7 +518,7 @@ fn build(run_dir: &Path, limit: u64) -> Result<String> {
             "strategy": e.strategy,
             "sampler": e.sampler,
             "integrand": e.integrand,
-            "file": path.display().to_string(),
+            "file": format!("{stem}.exr"),
             "pixels": image,
             "variance": variance,
             "flip": flip,

@@ -163,7 +163,8 @@ fn embedded_pixels_round_trip_to_the_exr_values() {
         let name = im["name"].as_str().unwrap();
         let px = &blocks[im["pixels"].as_str().unwrap()];
         let exr = if name == "reference" {
-            read_exr(Path::new(im["file"].as_str().unwrap())).unwrap()
+            // The file name is relative to the run directory.
+            read_exr(&run.join(im["file"].as_str().unwrap())).unwrap()
         } else {
             read_exr(&run.join(format!("{name}.exr"))).unwrap()
         };
