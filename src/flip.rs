@@ -93,6 +93,12 @@ impl FlipMap {
     }
 }
 
+/// HDR-FLIP's peak working memory in units of an f64 RGB image (24 bytes per pixel), for
+/// callers that check memory before rendering: the two f32 inputs, their tone-mapped,
+/// YCxCz, filtered L*a*b* and feature images, and the maps come to about 160 bytes per
+/// pixel; 8 × 24 = 192 bounds it.
+pub const WORKING_IMAGES: u64 = 8;
+
 /// What a FLIP map's EXR holds (`Provenance::content`).
 pub const CONTENT: &str = "HDR-FLIP error";
 

@@ -92,7 +92,9 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
     // References (one per integrand), the film's mean, its variance and a checkpoint's mean;
     // then per (strategy, sampler, run) its rows and summary input, about 3 kB.
     let integrands = strategy::integrands(&scene).len() as u64;
-    check_image_memory(&scene, integrands + 3)?;
+    // … and HDR-FLIP's working images at the end of each run.
+    let images = integrands + 3 + crate::flip::WORKING_IMAGES;
+    check_image_memory(&scene, images)?;
     crate::bounded::check_memory(
         || {
             format!(
@@ -101,7 +103,7 @@ pub fn run(a: CompareArgs, strategies: Vec<Box<dyn Strategy>>) -> Result<()> {
                 run.len()
             )
         },
-        image_memory(&scene, integrands + 3).saturating_add(crate::bounded::bytes(
+        image_memory(&scene, images).saturating_add(crate::bounded::bytes(
             (a.runs as u64 * run.len() as u64).saturating_mul(samplers),
             3000,
         )),
