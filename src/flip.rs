@@ -30,9 +30,9 @@
 //!   here its maximum luminance too: the reference exits on an all-black reference (start
 //!   exposure ∞ > stop), this port uses start = stop = log₂(0.85-point / ε) ≈ 24.1. An exposure
 //!   whose log₂ overflows f32 (a luminance above ~1e38) is computed in f64;
-//! - HDR: exposed values are limited to ±1e10 before tone mapping (the ACES fit is ≥ 1, hence
-//!   clamped to 1, above 12.1, so this changes nothing but squares that would overflow to ∞ and
-//!   give ∞/∞ = NaN); 0·∞ when an exposure overflows is taken as 0;
+//! - HDR: the ACES fit is evaluated, for |c| > 1e18, divided through by c², so a huge exposed
+//!   value (the reference's form squares it to ∞ and gives ∞/∞ = NaN) gets the fit's limit;
+//!   explicit exposures above 127 stops (2^e not a finite f32) are refused;
 //! - a filter whose derivative weights all underflow (pixels per degree below about 1.7)
 //!   gets zero derivative weights instead of 0/0 = NaN.
 
@@ -546,14 +546,8 @@ pub fn ldr_flip(
     height: usize,
     ppd: f32,
 ) -> Result<FlipMap> {
-    check(reference, test, width, height, ppd)?;
-    let lin =
-        |img: &[C3]| -> Vec<C3> { img.iter().map(|c| clamp01(c.map(srgb_to_linear))).collect() };
-    let values = ldr_core(&lin(reference), &lin(test), width, height, ppd);
-    Ok(FlipMap {
-        width,
-        height,
-        values,
+    ldr_decoded(reference, test, width, height, ppd, |c| {
+        clamp01(c.map(srgb_to_linear))
     })
 }
 
@@ -566,9 +560,21 @@ pub fn ldr_flip_linear(
     height: usize,
     ppd: f32,
 ) -> Result<FlipMap> {
+    ldr_decoded(reference, test, width, height, ppd, clamp01)
+}
+
+/// LDR-FLIP of the two images after `decode` maps each pixel to linear RGB in [0, 1].
+fn ldr_decoded(
+    reference: &[C3],
+    test: &[C3],
+    width: usize,
+    height: usize,
+    ppd: f32,
+    decode: fn(C3) -> C3,
+) -> Result<FlipMap> {
     check(reference, test, width, height, ppd)?;
-    let clamp = |img: &[C3]| -> Vec<C3> { img.iter().map(|&c| clamp01(c)).collect() };
-    let values = ldr_core(&clamp(reference), &clamp(test), width, height, ppd);
+    let lin = |img: &[C3]| -> Vec<C3> { img.iter().map(|&c| decode(c)).collect() };
+    let values = ldr_core(&lin(reference), &lin(test), width, height, ppd);
     Ok(FlipMap {
         width,
         height,
@@ -587,13 +593,22 @@ const ACES: [f32; 6] = [
     0.14,
 ];
 
-/// Exposed values are limited to this before tone mapping (see the module documentation).
-const EXPOSED_LIMIT: f32 = 1e10;
-
+/// The ACES fit, in the reference's form where c² is representable; beyond |c| = 1e18, where
+/// that form would square c to ∞ and give ∞/∞, numerator and denominator divided by c² (there
+/// both forms equal t0/t3 to f32 precision, the 1/c terms being below 1e-18, and the divided
+/// one is exactly t0/t3 at c = ±∞). Neither denominator has a real root.
 fn aces(c: f32) -> f32 {
     let t = &ACES;
-    ((c * c) * t[0] + c * t[1] + t[2]) / (c * c * t[3] + c * t[4] + t[5])
+    if c.abs() > 1e18 {
+        let r = 1.0 / c;
+        (t[0] + r * (t[1] + r * t[2])) / (t[3] + r * (t[4] + r * t[5]))
+    } else {
+        ((c * c) * t[0] + c * t[1] + t[2]) / (c * c * t[3] + c * t[4] + t[5])
+    }
 }
+
+/// Largest exposure, in stops, whose 2^exposure is a finite f32.
+const MAX_EXPOSURE: f32 = 127.0;
 
 /// HDR-FLIP's automatic exposures from the reference (linear RGB): the start exposure maps
 /// the largest luminance, the stop exposure the median luminance, to where the tone mapper
@@ -664,9 +679,11 @@ pub fn hdr_flip_with(
     check(reference, test, width, height, ppd)?;
     let exposures = match exposures {
         Some(e) => {
-            if !(e.start.is_finite() && e.stop.is_finite() && e.start <= e.stop && e.count >= 2) {
+            if !(e.start <= e.stop && e.stop <= MAX_EXPOSURE && e.start.is_finite() && e.count >= 2)
+            {
                 return Err(Error::Usage(format!(
-                    "FLIP: exposures need finite start ≤ stop and a count of 2 or more, not {e:?}"
+                    "FLIP: exposures need a finite start ≤ stop ≤ {MAX_EXPOSURE} (2^stop a finite \
+                     f32) and a count of 2 or more, not {e:?}"
                 )));
             }
             e
@@ -682,9 +699,9 @@ pub fn hdr_flip_with(
             img.par_iter()
                 .map(|c| {
                     c.map(|v| {
-                        let e = v * m;
-                        let e = if e.is_nan() { 0.0 } else { e };
-                        aces(e.clamp(-EXPOSED_LIMIT, EXPOSED_LIMIT)).clamp(0.0, 1.0)
+                        // m is finite and positive, v finite: v·m is never NaN (at most ±∞,
+                        // which `aces` takes).
+                        aces(v * m).clamp(0.0, 1.0)
                     })
                 })
                 .collect()
