@@ -1053,6 +1053,28 @@ mod tests {
         }
     }
 
+    /// The ACES fit is finite for every input, ±∞ included, and continuous where it switches
+    /// form; the reference's form alone gives ∞/∞ = NaN there (the negative control).
+    #[test]
+    fn aces_is_finite_everywhere_and_continuous_at_its_switch() {
+        let limit = ACES[0] / ACES[3];
+        for c in [f32::INFINITY, f32::NEG_INFINITY, f32::MAX, -f32::MAX, 1e30] {
+            assert!(
+                (aces(c) - limit).abs() <= limit * f32::EPSILON,
+                "{c}: {}",
+                aces(c)
+            );
+        }
+        let (below, above) = (aces(1e18), aces(1e18f32.next_up()));
+        assert!(
+            (below - above).abs() <= limit * f32::EPSILON,
+            "{below} {above}"
+        );
+        let t = &ACES;
+        let direct = |c: f32| ((c * c) * t[0] + c * t[1] + t[2]) / (c * c * t[3] + c * t[4] + t[5]);
+        assert!(direct(1e30).is_nan());
+    }
+
     #[test]
     fn bad_input_is_an_error_not_a_panic() {
         let a = vec![[0.5f32; 3]; 12];
@@ -1074,6 +1096,19 @@ mod tests {
             count: 2,
         };
         assert!(hdr_flip_with(&a, &a, 4, 3, DEFAULT_PPD, Some(bad)).is_err());
+        // 2^200 is no finite f32; 2^127 is.
+        let over = Exposures {
+            start: 0.0,
+            stop: 200.0,
+            count: 2,
+        };
+        assert!(hdr_flip_with(&a, &a, 4, 3, DEFAULT_PPD, Some(over)).is_err());
+        let top = Exposures {
+            stop: MAX_EXPOSURE,
+            ..over
+        };
+        let hd = hdr_flip_with(&a, &a, 4, 3, DEFAULT_PPD, Some(top)).unwrap();
+        assert!(finite_in_unit(&hd.map));
         let img = |w: u32, h: u32| Image {
             width: w,
             height: h,

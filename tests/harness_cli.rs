@@ -7,6 +7,20 @@ use common::{TINY_WITH_AO as SCENE, dibench, stored_file};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// A CSV text's rows split into fields, and a column's index by its header name.
+fn columns(text: &str) -> (impl Fn(&str) -> usize + '_, Vec<Vec<&str>>) {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let rows = lines.map(|l| l.split(',').collect()).collect();
+    let col = move |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column `{name}`"))
+    };
+    (col, rows)
+}
+
 fn run_dirs(scene_dir: &Path) -> Vec<PathBuf> {
     std::fs::read_dir(scene_dir)
         .unwrap()
@@ -604,10 +618,7 @@ fn compare_with_two_samplers() {
         assert!(!run_dir.join(format!("{s}.sobol.variance.exr")).exists());
     }
     let summary = std::fs::read_to_string(run_dir.join("summary.csv")).unwrap();
-    let mut lines = summary.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let (col, rows) = columns(&summary);
     assert_eq!(rows.len(), 4, "{summary}");
     for r in &rows {
         let predicted = r[col("predicted_rmse")];
@@ -686,10 +697,7 @@ fn compare_at_equal_spp() {
     assert!(!stdout.contains("deviation from the budget"), "{stdout}");
     let run_dir = &run_dirs(&dir.path().join("out/tiny"))[0];
     let results = std::fs::read_to_string(run_dir.join("results.csv")).unwrap();
-    let mut lines = results.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let (col, rows) = columns(&results);
     // 2 strategies × 3 samplers × 2 runs, five checkpoint rows each.
     assert_eq!(rows.len(), 2 * 3 * 2 * 5, "{results}");
     for r in &rows {
@@ -710,10 +718,7 @@ fn compare_at_equal_spp() {
         );
     }
     let summary = std::fs::read_to_string(run_dir.join("summary.csv")).unwrap();
-    let mut lines = summary.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let (col, rows) = columns(&summary);
     assert_eq!(rows.len(), 6, "{summary}");
     for r in &rows {
         assert_eq!(r[col("budget_spp")], "16", "{summary}");
@@ -770,10 +775,7 @@ fn compare_at_equal_spp() {
     // FLIP: the final row of each run has it, the earlier ones not; run 0's value is the
     // HDR-FLIP of the EXRs on disk (recomputed here), whose map is <stem>.flip.exr.
     let results = std::fs::read_to_string(run_dir.join("results.csv")).unwrap();
-    let mut lines = results.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let (col, rows) = columns(&results);
     for r in &rows {
         assert_eq!(
             r[col("flip")].is_empty(),
@@ -804,13 +806,11 @@ fn compare_at_equal_spp() {
         .unwrap();
     assert_eq!(fp.content, dibench::flip::CONTENT);
     let summary = std::fs::read_to_string(run_dir.join("summary.csv")).unwrap();
+    let (col, rows) = columns(&summary);
     assert!(
-        summary.lines().skip(1).all(|l| {
-            let f: Vec<&str> = l.split(',').collect();
-            f[f.len() - 2]
-                .parse::<f64>()
-                .is_ok_and(|m| m > 0.0 && m < 1.0)
-        }),
+        rows.iter().all(|r| r[col("flip_mean")]
+            .parse::<f64>()
+            .is_ok_and(|m| m > 0.0 && m < 1.0)),
         "flip_mean: {summary}"
     );
     // The spp chart: x in samples per pixel, one curve per pair with its slope.

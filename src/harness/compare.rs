@@ -136,7 +136,7 @@ pub struct ResultRow {
     pub sampler: String,
     /// Mean HDR-FLIP against the reference (`crate::flip`, Andersson et al. 2020/2021) of the
     /// final (equal-budget) image; empty at the earlier checkpoints, where it is not computed
-    /// (it costs about as much as a few passes).
+    /// (the summary and the report use the final image's only).
     #[serde(default)]
     pub flip: Option<f64>,
 }
@@ -215,11 +215,11 @@ pub fn run_strategy(
     let name = strategy.name();
     let sampler = generator.name().to_string();
     let mut film = Film::new(scene.scene.width, scene.scene.height);
-    // Validated where the options are built (`--time`); saturating for other callers.
     let _polling = crate::interrupt::polling();
     let scale = |k: u32| 2f64.powi((CHECKPOINTS - 1 - k) as i32);
     // Whether checkpoint k has been reached after `spp` passes taking `elapsed`.
     let reached = |k: u32, spp: u64, elapsed: Duration| match opts.budget {
+        // `--time` is validated where the options are built; saturating for other callers.
         Budget::Time(t) => {
             elapsed >= Duration::try_from_secs_f64(t / scale(k)).unwrap_or(Duration::MAX)
         }
