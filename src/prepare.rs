@@ -26,6 +26,9 @@ pub struct World {
     pub geometry: Arc<Geometry>,
     pub prim_material: Vec<u32>,
     pub prim_emitter: Vec<Option<EmitterRef>>,
+    /// Each triangle's unit geometric normal, computed once here rather than per hit (its
+    /// square root and division were 8 % of a `light` sample on `cornell`, `perf record`).
+    pub triangle_normals: Vec<Vec3>,
     pub materials: Vec<Bsdf>,
     /// Occlusion distance of the ambient-occlusion integrand, when the scene asks for it.
     pub ao_distance: Option<f32>,
@@ -89,7 +92,8 @@ impl World {
                 let t = &self.geometry.triangles[hit.prim as usize];
                 // Barycentric position: more accurate than o + t·d, which matters for offsets.
                 let (u, v) = (hit.u, hit.v);
-                (t.point(u, v), t.point_error(u, v), t.cross().normalize())
+                let ng = self.triangle_normals[hit.prim as usize];
+                (t.point(u, v), t.point_error(u, v), ng)
             }
             Some(s) => {
                 let s = &self.geometry.spheres[s];
@@ -199,6 +203,7 @@ impl PreparedScene {
             (lights.len() - 1, env)
         });
         let materials = scene.materials.iter().map(|m| m.bsdf.clone()).collect();
+        let triangle_normals = g.triangles.iter().map(|t| t.cross().normalize()).collect();
         let geometry = Arc::new(g);
         let tracer = make_tracer(geometry.clone());
         PreparedScene {
@@ -206,6 +211,7 @@ impl PreparedScene {
                 geometry,
                 prim_material,
                 prim_emitter,
+                triangle_normals,
                 materials,
                 ao_distance: scene.ao_distance,
                 radius,

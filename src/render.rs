@@ -197,26 +197,26 @@ impl<'a> Renderer<'a> {
         let mut cam = RayPacket::default();
         let mut active: LaneMask = 0;
         let mut pixels = [u32::MAX; LANES];
-        for (lane, pixel_of) in pixels.iter_mut().enumerate() {
+        let mut coords = [(0, 0); LANES];
+        for (lane, (pixel_of, xy)) in pixels.iter_mut().zip(coords.iter_mut()).enumerate() {
             if let Some((x, y)) = shape.lane_pixel(tile, lane) {
-                let pixel = y * w + x;
-                let values = &mut out.values[lane][..self.dims];
-                self.generator.fill(
-                    &self.setup,
-                    SampleKey {
-                        seed: self.seed,
-                        strategy: self.strategy_id,
-                        pixel: pixel as u64,
-                        index: pass,
-                    },
-                    values,
-                );
-                cam.set(
-                    lane,
-                    &camera_ray(camera, w, h, x, y, [values[0], values[1]]),
-                );
-                *pixel_of = pixel;
+                *pixel_of = y * w + x;
+                *xy = (x, y);
                 active |= 1 << lane;
+            }
+        }
+        let keys = pixels.map(|pixel| SampleKey {
+            seed: self.seed,
+            strategy: self.strategy_id,
+            pixel: pixel as u64,
+            index: pass,
+        });
+        self.generator
+            .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
+        for (lane, &(x, y)) in coords.iter().enumerate() {
+            if active & (1 << lane) != 0 {
+                let v = &out.values[lane];
+                cam.set(lane, &camera_ray(camera, w, h, x, y, [v[0], v[1]]));
             }
         }
         let mut hits = HitPacket::default();

@@ -5,6 +5,8 @@
 //! from its [`SampleKey`], so the renderer calls it once per pixel and pass, and a strategy reads
 //! its dimensions in order through [`Dims`].
 
+use crate::simd::{Mask, WIDTH};
+
 /// Every sample's identity: one generator output per (seed, strategy, pixel, sample index),
 /// so an image depends on the seed and never on thread scheduling or tile order. Pass k of a
 /// render is sample index k of each pixel.
@@ -77,6 +79,25 @@ pub trait SampleGenerator: Send + Sync {
     /// Writes dimensions 0..out.len() of sample `key`, each in [0, 1); `out.len()` is at most
     /// `setup.layout.len()`. Must depend on (setup, key) alone.
     fn fill(&self, setup: &Setup, key: SampleKey, out: &mut [f32]);
+
+    /// One packet's samples at once: `out[i][..dims]` = [`Self::fill`] of `keys[i]` for every
+    /// lane i whose bit is set in `lanes` (other lanes are left as they are). The default fills
+    /// lane by lane; a generator whose lanes can be computed side by side overrides it, and
+    /// must give the same numbers (the `lanes_fill_as_single_samples` test).
+    fn fill_lanes(
+        &self,
+        setup: &Setup,
+        keys: &[SampleKey; WIDTH],
+        lanes: Mask,
+        dims: usize,
+        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    ) {
+        for (lane, (key, o)) in keys.iter().zip(out.iter_mut()).enumerate() {
+            if lanes & (1 << lane) != 0 {
+                self.fill(setup, *key, &mut o[..dims]);
+            }
+        }
+    }
 }
 
 /// One group of dimensions of a layout: one number, or a 2-D pair that a stratifying
@@ -200,5 +221,51 @@ impl<'a> Dims<'a> {
     /// The dimensions not read yet (for a strategy that hands them to a part of its own).
     pub fn remaining(&self) -> usize {
         self.values.len() - self.next
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::GENERATORS;
+
+    /// Every generator's packet fill gives each active lane exactly its single-sample fill, and
+    /// leaves inactive lanes alone (the renderer fills packets, closed-form checks single
+    /// samples: both must see the same numbers).
+    #[test]
+    fn lanes_fill_as_single_samples() {
+        let layout = Layout::of(&[
+            Dimension::pair("a"),
+            Dimension::one("b"),
+            Dimension::pair("c"),
+            Dimension::one("d"),
+        ]);
+        let setup = Setup::image(layout, Some(16), 13, 7);
+        let dims = setup.layout.len();
+        for g in GENERATORS.iter() {
+            for (lanes, index) in [(0xffffu16, 0u64), (0b1010_0110_0101_1001, 5), (1, 15)] {
+                let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
+                    // One lane of another stream family: a packet need not share one.
+                    seed: if i == 7 { 4 } else { 3 },
+                    strategy: 0xabcd,
+                    pixel: (i as u64 * 5) % 91,
+                    index,
+                });
+                let mut got = [[-1.0f32; MAX_DIMENSIONS]; WIDTH];
+                g.fill_lanes(&setup, &keys, lanes, dims, &mut got);
+                for (lane, row) in got.iter().enumerate() {
+                    let mut want = [-1.0f32; MAX_DIMENSIONS];
+                    if lanes & (1 << lane) != 0 {
+                        g.fill(&setup, keys[lane], &mut want[..dims]);
+                    }
+                    assert_eq!(
+                        row.map(f32::to_bits),
+                        want.map(f32::to_bits),
+                        "{} lane {lane}",
+                        g.name()
+                    );
+                }
+            }
+        }
     }
 }

@@ -3,7 +3,8 @@
 //! sample is independent of every other, so per-pixel sample variances are variances of i.i.d.
 //! draws — the assumption the harness's error predictions make.
 
-use super::generator::{SampleGenerator, SampleKey, Setup};
+use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
+use crate::simd::{Mask, WIDTH};
 use super::stream::SampleStream;
 
 pub struct Independent;
@@ -27,6 +28,36 @@ impl SampleGenerator for Independent {
         let mut s = SampleStream::new(key.seed, key.strategy, key.pixel, key.index);
         for x in out {
             *x = s.next_1d();
+        }
+    }
+
+    /// All lanes side by side, dimension by dimension: sixteen independent multiply chains
+    /// instead of one at a time (inactive lanes are computed and discarded).
+    fn fill_lanes(
+        &self,
+        _setup: &Setup,
+        keys: &[SampleKey; WIDTH],
+        lanes: Mask,
+        dims: usize,
+        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    ) {
+        let first = (keys[0].seed, keys[0].strategy);
+        let base = SampleStream::base(first.0, first.1);
+        let mut streams: [SampleStream; WIDTH] = std::array::from_fn(|i| {
+            let k = &keys[i];
+            if (k.seed, k.strategy) == first {
+                SampleStream::keyed(base, k.pixel, k.index)
+            } else {
+                SampleStream::new(k.seed, k.strategy, k.pixel, k.index)
+            }
+        });
+        for d in 0..dims {
+            for (lane, s) in streams.iter_mut().enumerate() {
+                let x = s.next_1d();
+                if lanes & (1 << lane) != 0 {
+                    out[lane][d] = x;
+                }
+            }
         }
     }
 }
