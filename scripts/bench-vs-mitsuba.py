@@ -24,8 +24,9 @@ Each scene's TOML is translated into a Mitsuba scene dict:
            (Mitsuba's u = atan2(x, −z)/2π, dibench's atan2(z, x)/2π; Mitsuba interpolates
            texels bilinearly, dibench's are piecewise constant); constant -> `constant`.
 Estimators: `light` (one light sample by area) <-> `direct` emitter_samples=1, bsdf_samples=0;
-`mis-power` <-> emitter_samples=1, bsdf_samples=1 (power heuristic on both sides; dibench
-samples quads and mesh triangles by solid angle there, Mitsuba by area). With an environment,
+`mis-power` <-> emitter_samples=1, bsdf_samples=1 (power heuristic on both sides), run as
+dibench's `mis-power-area` where it applies (quads and mesh triangles by area, as Mitsuba samples
+them), else `mis-power` (spheres: the cone on both sides). With an environment,
 dibench's env-latlong-hier / mis-env-latlong-hier (Mitsuba's envmap warps hierarchically).
 Mitsuba picks a light uniformly, dibench by power: the same for the one-light scenes here.
 
@@ -49,6 +50,13 @@ from pathlib import Path
 
 LLVM_DEFAULT = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
 ESTIMATORS = {"light": (1, 0), "mis-power": (1, 1)}  # (emitter_samples, bsdf_samples)
+
+
+def applies(exe, scene, strategy):
+    """Whether `dibench strategies SCENE` lists `strategy` as applying."""
+    listing = subprocess.run([exe, "strategies", scene], capture_output=True, text=True, check=True).stdout
+    return any(line.split()[:1] == [strategy] and line.rstrip().endswith("[applies]")
+               for line in listing.splitlines())
 
 
 def import_mitsuba(out):
@@ -215,7 +223,12 @@ def main():
                 d, (w, h), env = mitsuba_scene(mi, Path("scenes") / f"{name}.toml", out, ne, nb)
             except (ValueError, KeyError, OSError) as e:
                 sys.exit(f"{name}: cannot translate to Mitsuba: {e}")
-            strat = {"light": "env-latlong-hier", "mis-power": "mis-env-latlong-hier"}[est] if env else est
+            if env:
+                strat = {"light": "env-latlong-hier", "mis-power": "mis-env-latlong-hier"}[est]
+            elif est == "mis-power" and applies(exe, name, "mis-power-area"):
+                strat = "mis-power-area"  # lights by area, as Mitsuba's `direct` samples them
+            else:
+                strat = est
             scene = mi.load_dict(d)
             time_mitsuba(mi, dr, scene, args.spp, 0)  # JIT compilation, untimed
             scenes[name, est] = (scene, w * h, strat)

@@ -9,7 +9,9 @@
 # coverage.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo test --release
+# The suite in the `test-release` profile (release without fat LTO: see Cargo.toml); the system
+# tests then drive the release binary a user runs.
+cargo test --profile test-release
 cargo build --release --bins --example exr_pixel
 scripts/install-test-tools.sh
 scripts/test-exr-metadata.sh
@@ -20,6 +22,6 @@ shots=$(mktemp -d)
 SCREENSHOTS="$shots" scripts/test-browser.sh
 rm -rf "$shots"
 scripts/setup-embree.sh
-cargo test --release --features embree --lib \
+cargo test --profile test-release --features embree --lib \
     --test embree --test backend_cli --test rays_cli --test harness_cli --test adversarial \
     --test packet --test watertight --test determinism

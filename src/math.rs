@@ -51,12 +51,8 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3) -> Vec3 {
     let off = offset.to_array();
     Vec3::from_array(std::array::from_fn(|k| {
         let stepped = next_f32(po[k], off[k] > 0.0);
-        // NaN compares false both ways: not moved, as a zero offset.
-        if off[k] > 0.0 || off[k] < 0.0 {
-            stepped
-        } else {
-            po[k]
-        }
+        // A zero or NaN offset does not move the point.
+        if off[k].abs() > 0.0 { stepped } else { po[k] }
     }))
 }
 

@@ -31,8 +31,8 @@ impl SampleGenerator for Independent {
         }
     }
 
-    /// All lanes side by side, dimension by dimension: sixteen independent multiply chains
-    /// instead of one at a time (inactive lanes are computed and discarded).
+    /// The packet's streams with the per-(seed, strategy) part of their keys computed once, not
+    /// once per lane (two of the four SplitMix rounds of a key).
     fn fill_lanes(
         &self,
         _setup: &Setup,
@@ -51,11 +51,10 @@ impl SampleGenerator for Independent {
                 SampleStream::new(k.seed, k.strategy, k.pixel, k.index)
             }
         });
-        for d in 0..dims {
-            for (lane, s) in streams.iter_mut().enumerate() {
-                let x = s.next_1d();
-                if lanes & (1 << lane) != 0 {
-                    out[lane][d] = x;
+        for (lane, (s, o)) in streams.iter_mut().zip(out.iter_mut()).enumerate() {
+            if lanes & (1 << lane) != 0 {
+                for x in &mut o[..dims] {
+                    *x = s.next_1d();
                 }
             }
         }

@@ -112,7 +112,11 @@ mod tests {
             let mut ours = SampleStream::from_u64(key);
             let mut theirs = rand_pcg::Pcg32::seed_from_u64(key);
             for draw in 0..24 {
-                assert_eq!(ours.next_u32(), theirs.next_u32(), "key {key:#x}, draw {draw}");
+                assert_eq!(
+                    ours.next_u32(),
+                    theirs.next_u32(),
+                    "key {key:#x}, draw {draw}"
+                );
             }
         }
     }

@@ -49,6 +49,34 @@ pub struct Mis {
     pub env: Option<EnvMethod>,
     pub selector: &'static SelectorType,
     pub sampling: BsdfSampling,
+    /// How lights are sampled: in solid angle where the scene allows it (the default), or by
+    /// area as `light` samples them (and as Mitsuba 3's `direct` does).
+    pub light_sampling: MisLights,
+}
+
+/// The light-sampling methods of an MIS variant's light sample (and of its light pdf).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MisLights {
+    /// [`LightMethods::SOLID_ANGLE`]: spherical rectangles and triangles.
+    SolidAngle,
+    /// [`LightMethods::BASIC`]: quads and mesh triangles uniform by area.
+    Area,
+}
+
+impl MisLights {
+    fn methods(self) -> LightMethods {
+        match self {
+            MisLights::SolidAngle => LightMethods::SOLID_ANGLE,
+            MisLights::Area => LightMethods::BASIC,
+        }
+    }
+
+    fn name_suffix(self) -> &'static str {
+        match self {
+            MisLights::SolidAngle => "",
+            MisLights::Area => "-area",
+        }
+    }
 }
 
 impl Mis {
@@ -59,6 +87,7 @@ impl Mis {
             env: None,
             selector: default_selector(),
             sampling: BsdfSampling::default(),
+            light_sampling: MisLights::SolidAngle,
         }
     }
 
@@ -78,10 +107,18 @@ impl Mis {
         }
     }
 
+    /// `mis-power-area`: lights sampled by area.
+    pub fn by_area(heuristic: Heuristic) -> Self {
+        Mis {
+            light_sampling: MisLights::Area,
+            ..Self::new(heuristic)
+        }
+    }
+
     fn methods(&self) -> LightMethods {
         LightMethods {
             env: self.env.unwrap_or(EnvMethod::LATLONG_CDF),
-            ..LightMethods::SOLID_ANGLE
+            ..self.light_sampling.methods()
         }
     }
 }
@@ -94,7 +131,11 @@ impl Strategy for Mis {
             (None, h) => format!("mis-{}", h.name()),
         };
         with_selector(
-            format!("{base}{}", self.sampling.name_suffix()),
+            format!(
+                "{base}{}{}",
+                self.light_sampling.name_suffix(),
+                self.sampling.name_suffix()
+            ),
             self.selector,
         )
     }
@@ -106,6 +147,10 @@ impl Strategy for Mis {
                 "as `mis-{}`, but the light chosen by the `{}` selector",
                 self.heuristic.name(),
                 self.selector.name
+            ),
+            None if self.light_sampling == MisLights::Area => format!(
+                "as `mis-{}`, lights sampled by area as `light` samples them (quads and mesh triangles uniform by area)",
+                self.heuristic.name()
             ),
             None => format!(
                 "one light sample (solid angle) + one BSDF sample, {} heuristic",
@@ -145,6 +190,24 @@ impl Strategy for Mis {
                 );
             }
             _ => {}
+        }
+        if self.light_sampling != MisLights::SolidAngle {
+            let other = Mis {
+                light_sampling: MisLights::SolidAngle,
+                ..*self
+            };
+            let here =
+                |m: &Mis| BoundLights::bind(&scene, self.selector, m.methods()).map(|b| b.methods);
+            let (mine, theirs) = (lights.methods, here(&other)?);
+            let differs = (scene.lights.has(LightShape::Quad) && mine.quad != theirs.quad)
+                || (scene.lights.has(LightShape::Mesh) && mine.mesh != theirs.mesh)
+                || (scene.lights.has(LightShape::Sphere) && mine.sphere != theirs.sphere);
+            if !differs {
+                return Err(format!(
+                    "identical to `{}`: its lights are sampled the same way by area and in solid angle",
+                    other.name()
+                ));
+            }
         }
         if let Some(why) = self.sampling.same_as_default(&scene.world.materials) {
             let default = Mis {

@@ -276,6 +276,7 @@ pub fn registry() -> Vec<Box<dyn Strategy>> {
     for h in Heuristic::ALL {
         v.push(Box::new(Mis::new(h)));
     }
+    v.push(Box::new(Mis::by_area(Heuristic::Power)));
     for s in crate::bsdf::BsdfSampling::variants() {
         v.push(Box::new(Mis::with_sampling(Heuristic::Power, s)));
     }
