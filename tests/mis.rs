@@ -110,3 +110,18 @@ fn mis_weights_are_the_heuristics_and_sum_to_one() {
         );
     }
 }
+
+/// `mis-power-area` applies where some light's area and solid-angle samplers differ (a quad,
+/// a mesh light) and is refused as `mis-power` itself elsewhere (a sphere: the cone both ways).
+#[test]
+fn area_mis_applies_only_where_it_differs() {
+    use dibench::strategy::applies;
+    let load =
+        |name: &str| PreparedScene::new(Scene::load(&Scene::resolve(name).unwrap()).unwrap());
+    let area = by_name("mis-power-area").unwrap();
+    for name in ["cornell", "mesh_light"] {
+        assert_eq!(applies(area.as_ref(), &load(name)), Ok(()), "{name}");
+    }
+    let why = applies(area.as_ref(), &load("sphere_light")).unwrap_err();
+    assert!(why.contains("identical to `mis-power`"), "{why}");
+}

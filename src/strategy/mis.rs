@@ -196,9 +196,8 @@ impl Strategy for Mis {
                 light_sampling: MisLights::SolidAngle,
                 ..*self
             };
-            let here =
-                |m: &Mis| BoundLights::bind(&scene, self.selector, m.methods()).map(|b| b.methods);
-            let (mine, theirs) = (lights.methods, here(&other)?);
+            let (mine, theirs) = (lights.methods, scene.lights.usable_methods(other.methods()));
+            // Only the shapes the scene has: their methods are what the two would run.
             let differs = (scene.lights.has(LightShape::Quad) && mine.quad != theirs.quad)
                 || (scene.lights.has(LightShape::Mesh) && mine.mesh != theirs.mesh)
                 || (scene.lights.has(LightShape::Sphere) && mine.sphere != theirs.sphere);
