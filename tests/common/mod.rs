@@ -401,16 +401,20 @@ pub const QUICK_COMPARE: [&str; 12] = [
     "out",
 ];
 
-/// A quad light over a floor with a sphere: light and direction strategies both apply, and
-/// an [ambient_occlusion] section adds the AO integrand.
-pub const TINY_WITH_AO: &str = r#"
+/// The tiny scenes' text: a quad light over a floor, `height` pixels tall, then `extra`.
+macro_rules! tiny_scene {
+    ($height:literal, $extra:literal) => {
+        concat!(
+            r#"
 [camera]
 eye = [0.0, 1.0, 3.0]
 look_at = [0.0, 0.0, 0.0]
 fov_y_deg = 40.0
 [image]
 width = 16
-height = 12
+height = "#,
+            $height,
+            r#"
 [[material]]
 name = "m"
 albedo = [0.5, 0.5, 0.5]
@@ -425,35 +429,24 @@ edge_u = [1.0, 0.0, 0.0]
 edge_v = [0.0, 0.0, 1.0]
 material = "m"
 emission = [4.0, 4.0, 4.0]
-[[sphere]]
+"#,
+            $extra
+        )
+    };
+}
+
+/// A quad light over a floor with a sphere: light and direction strategies both apply, and
+/// an [ambient_occlusion] section adds the AO integrand.
+pub const TINY_WITH_AO: &str = tiny_scene!(
+    12,
+    r#"[[sphere]]
 center = [0.3, 0.3, 0.0]
 radius = 0.3
 material = "m"
 [ambient_occlusion]
 distance = 0.5
-"#;
+"#
+);
 
 /// A small scene: a quad light over a floor, so light and direction strategies apply.
-pub const TINY: &str = r#"
-[camera]
-eye = [0.0, 1.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y_deg = 40.0
-[image]
-width = 16
-height = 16
-[[material]]
-name = "m"
-albedo = [0.5, 0.5, 0.5]
-[[quad]]
-corner = [-3.0, 0.0, -3.0]
-edge_u = [0.0, 0.0, 6.0]
-edge_v = [6.0, 0.0, 0.0]
-material = "m"
-[[quad]]
-corner = [-0.5, 1.5, -0.5]
-edge_u = [1.0, 0.0, 0.0]
-edge_v = [0.0, 0.0, 1.0]
-material = "m"
-emission = [4.0, 4.0, 4.0]
-"#;
+pub const TINY: &str = tiny_scene!(16, "");
