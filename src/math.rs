@@ -1,5 +1,6 @@
 //! Small numeric helpers shared by geometry, samplers and the renderer.
 
+use crate::simd::{V3, Vector, WIDTH};
 use glam::Vec3;
 
 /// An orthonormal frame around a unit normal (Duff et al., "Building an Orthonormal Basis,
@@ -54,6 +55,27 @@ pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3) -> Vec3 {
         // A zero or NaN offset does not move the point.
         if off[k].abs() > 0.0 { stepped } else { po[k] }
     }))
+}
+
+/// [`offset_ray_origin`] over 16 lanes, bit for bit.
+#[inline(always)]
+pub fn offset_ray_origin_lanes<V: Vector<WIDTH>>(p: V3<V>, p_error: V3<V>, n: V3<V>) -> V3<V> {
+    let d = n.abs().dot(p_error);
+    let offset = n.scale(d);
+    let po = p + offset;
+    V3 {
+        x: step_off(po.x, offset.x),
+        y: step_off(po.y, offset.y),
+        z: step_off(po.z, offset.z),
+    }
+}
+
+/// One axis of [`offset_ray_origin_lanes`]: `po` one ulp further along `off`, unless `off` is
+/// zero or NaN.
+#[inline(always)]
+fn step_off<V: Vector<WIDTH>>(po: V, off: V) -> V {
+    let zero = V::splat(0.0);
+    V::select(zero.lt(off.abs()), po.next_f32(zero.lt(off)), po)
 }
 
 /// `x.next_up()` if `up`, else `x.next_down()`, bit for bit (the `next_f32_is_std` test),

@@ -27,6 +27,7 @@ crate::plugin::registry! {
 use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
+use crate::simd::{Isa, Soa3, WIDTH};
 use bounds::Bounds;
 use glam::Vec3;
 use selector::{LightSelector, SELECTORS, SelectorType};
@@ -282,6 +283,97 @@ impl LightMethods {
     }
 }
 
+/// The shading points of a packet's lanes that one light is sampled for at once (structure of
+/// arrays): what [`LightCtx`] and the three sample numbers are per lane.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LaneQuery {
+    /// Lanes to sample (bit i = lane i).
+    pub active: u32,
+    pub p: Soa3,
+    pub n: Soa3,
+    /// `u[k][lane]`: the sample numbers [`Light::sample`] takes.
+    pub u: [[f32; WIDTH]; 3],
+}
+
+impl LaneQuery {
+    pub fn ctx(&self, lane: usize) -> LightCtx {
+        LightCtx {
+            p: self.p.get(lane),
+            n: self.n.get(lane),
+        }
+    }
+}
+
+/// [`LightSample`]s of 16 lanes (structure of arrays); `valid` marks the lanes that have one.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LaneSamples {
+    pub valid: u32,
+    /// Lanes whose sample is at infinity ([`LightSample::distant`]).
+    pub distant: u32,
+    pub wi: Soa3,
+    pub point: Soa3,
+    pub normal: Soa3,
+    pub point_error: Soa3,
+    pub radiance: Soa3,
+    pub pdf: [f32; WIDTH],
+}
+
+impl LaneSamples {
+    /// Stores `s` as lane `lane`'s sample, or marks the lane as having none.
+    pub fn set(&mut self, lane: usize, s: Option<LightSample>) {
+        let bit = 1 << lane;
+        let Some(s) = s else {
+            self.valid &= !bit;
+            return;
+        };
+        self.valid |= bit;
+        self.distant = if s.distant {
+            self.distant | bit
+        } else {
+            self.distant & !bit
+        };
+        self.wi.set(lane, s.wi);
+        self.point.set(lane, s.point);
+        self.normal.set(lane, s.normal);
+        self.point_error.set(lane, s.point_error);
+        self.radiance.set(lane, s.radiance);
+        self.pdf[lane] = s.pdf;
+    }
+
+    /// Lane `lane`'s sample, if it has one.
+    pub fn get(&self, lane: usize) -> Option<LightSample> {
+        (self.valid >> lane & 1 != 0).then(|| LightSample {
+            wi: self.wi.get(lane),
+            point: self.point.get(lane),
+            normal: self.normal.get(lane),
+            point_error: self.point_error.get(lane),
+            radiance: self.radiance.get(lane),
+            pdf: self.pdf[lane],
+            distant: self.distant >> lane & 1 != 0,
+        })
+    }
+}
+
+/// [`Light::sample`] lane by lane: what [`Light::sample_lanes`] does for a light without a
+/// kernel over lanes, and for the methods a light's kernel does not cover.
+pub fn sample_lane_by_lane<T: Light + ?Sized>(
+    light: &T,
+    q: &LaneQuery,
+    m: &LightMethods,
+    out: &mut LaneSamples,
+) {
+    for lane in 0..WIDTH {
+        if q.active >> lane & 1 != 0 {
+            let u = [q.u[0][lane], q.u[1][lane], q.u[2][lane]];
+            out.set(lane, light.sample(&q.ctx(lane), u, m));
+        }
+    }
+}
+
+/// pbrt-v4's ShadowEpsilon: a shadow segment stops this fraction short of the (offset) light
+/// point.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
 impl LightSample {
     /// The unoccluded-test segment from a shading point (already offset) to the sample, with the
     /// light end offset off the light's own surface so the light does not shadow itself.
@@ -305,8 +397,7 @@ impl LightSample {
         if dist == 0.0 {
             return None;
         }
-        // pbrt-v4's ShadowEpsilon: stop just short of the (offset) light point.
-        Some(Ray::new(origin, d / dist, dist * (1.0 - 1e-4)))
+        Some(Ray::new(origin, d / dist, dist * (1.0 - SHADOW_EPSILON)))
     }
 }
 
@@ -383,6 +474,14 @@ pub trait Light: Send + Sync + std::fmt::Debug {
     /// bits of the selection number); None when the sample carries no light (the back of a
     /// one-sided emitter).
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample>;
+
+    /// [`Self::sample`] for the lanes of `q.active` at once, on the lane layer's `isa`: lane i
+    /// of `out` is what [`Self::sample`] returns for lane i, bit for bit (lanes outside
+    /// `q.active` are left as they were). The default samples lane by lane; a light with a
+    /// kernel over lanes overrides it for the methods the kernel covers (#19 part B).
+    fn sample_lanes(&self, _isa: Isa, q: &LaneQuery, m: &LightMethods, out: &mut LaneSamples) {
+        sample_lane_by_lane(self, q, m, out)
+    }
 
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to
     /// `at`. 0 for delta lights: no direction found by another strategy can reach them.

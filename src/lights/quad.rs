@@ -4,11 +4,13 @@
 
 use super::bounds::{Bounds, LightBounds};
 use super::{
-    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, QuadMethod, direction_to,
+    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
+    QuadMethod, direction_to, sample_lane_by_lane,
 };
 use crate::math::gamma;
 use crate::math::luminance;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
+use crate::simd::{self, Isa, Kernel, Lanes, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -57,6 +59,34 @@ impl QuadLight {
             pdf: d2 / (self.area * cos_l),
             distant: false,
         })
+    }
+
+    /// [`Self::sample_area`] for the lanes of `q.active` (u = `q.u[0..2]`), the same operations
+    /// in the same order over lanes; other lanes of `out` are kept.
+    #[inline(always)]
+    fn sample_area_lanes<V: Vector<WIDTH>>(&self, q: &LaneQuery, out: &mut LaneSamples) {
+        let zero = V::splat(0.0);
+        let (u0, u1) = (V::load(&q.u[0]), V::load(&q.u[1]));
+        let eu = V3::splat(self.edge_u).scale(u0);
+        let ev = V3::splat(self.edge_v).scale(u1);
+        let point = V3::splat(self.corner) + eu + ev;
+        // direction_to
+        let d = point - V3::load(&q.p);
+        let d2 = d.dot(d);
+        let wi = d / d2.sqrt();
+        let cos_l = V3::splat(self.normal).dot(wi).neg();
+        let valid = q.active & zero.lt(d2) & !cos_l.le(zero);
+        let error = (V3::splat(self.corner.abs()) + eu.abs() + ev.abs()).scale(V::splat(gamma(6)));
+        let pdf = d2.div(V::splat(self.area).mul(cos_l));
+        let a = q.active;
+        keep(a, wi, &mut out.wi);
+        keep(a, point, &mut out.point);
+        keep(a, V3::<V>::splat(self.normal), &mut out.normal);
+        keep(a, error, &mut out.point_error);
+        keep(a, V3::<V>::splat(self.radiance), &mut out.radiance);
+        V::select(a, pdf, V::load(&out.pdf)).store(&mut out.pdf);
+        out.valid = (out.valid & !a) | valid;
+        out.distant &= !a;
     }
 
     /// Solid-angle pdf of [`Self::sample_area`] for the direction that reaches light point q.
@@ -132,6 +162,12 @@ impl QuadLight {
     }
 }
 
+/// Stores lanes `m` of `new` into `old`, keeping its other lanes.
+#[inline(always)]
+fn keep<V: Vector<WIDTH>>(m: u32, new: V3<V>, old: &mut Soa3) {
+    V3::select(m, new, V3::load(old)).store(old)
+}
+
 impl Light for QuadLight {
     fn shape(&self) -> LightShape {
         LightShape::Quad
@@ -155,6 +191,21 @@ impl Light for QuadLight {
         match m.quad {
             QuadMethod::Area => self.sample_area(ctx.p, [u[0], u[1]]),
             QuadMethod::SolidAngle => self.sample_solid_angle(ctx.p, [u[0], u[1]]),
+        }
+    }
+
+    fn sample_lanes(&self, isa: Isa, q: &LaneQuery, m: &LightMethods, out: &mut LaneSamples) {
+        struct Area<'a>(&'a QuadLight, &'a LaneQuery, &'a mut LaneSamples);
+        impl Kernel for Area<'_> {
+            type Out = ();
+            #[inline(always)]
+            fn run<L: Lanes>(self) {
+                self.0.sample_area_lanes::<L::V>(self.1, self.2)
+            }
+        }
+        match m.quad {
+            QuadMethod::Area => simd::run(isa, Area(self, q, out)),
+            QuadMethod::SolidAngle => sample_lane_by_lane(self, q, m, out),
         }
     }
 

@@ -80,6 +80,42 @@ impl Vector<NARROW> for Y {
     fn abs(self) -> Self {
         unsafe { Y(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
     }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        unsafe { Y(_mm256_sqrt_ps(self.0)) }
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        unsafe { Y(_mm256_xor_ps(self.0, _mm256_set1_ps(-0.0))) }
+    }
+    /// `math::next_f32` on integer lanes: ±1 on the bits, ±0 to the smallest subnormal, NaN
+    /// and the infinity moved towards unchanged.
+    #[inline(always)]
+    fn next_f32(self, up: u32) -> Self {
+        unsafe {
+            let bits = _mm256_castps_si256(self.0);
+            let up = _mm256_castps_si256(expand(up));
+            let abs = _mm256_and_si256(bits, _mm256_set1_epi32(0x7fff_ffff));
+            let neg = _mm256_srai_epi32::<31>(bits);
+            // away from zero: up from a positive number, down from a negative one.
+            let away = _mm256_xor_si256(neg, up);
+            let one = _mm256_set1_epi32(1);
+            let stepped = _mm256_blendv_epi8(
+                _mm256_sub_epi32(bits, one),
+                _mm256_add_epi32(bits, one),
+                away,
+            );
+            let from_zero = _mm256_blendv_epi8(_mm256_set1_epi32(0x8000_0001u32 as i32), one, up);
+            let zero = _mm256_cmpeq_epi32(abs, _mm256_setzero_si256());
+            let r = _mm256_blendv_epi8(stepped, from_zero, zero);
+            let inf = _mm256_set1_epi32(0x7f80_0000);
+            let stays = _mm256_or_si256(
+                _mm256_cmpgt_epi32(abs, inf),
+                _mm256_and_si256(_mm256_cmpeq_epi32(abs, inf), away),
+            );
+            Y(_mm256_castsi256_ps(_mm256_blendv_epi8(r, bits, stays)))
+        }
+    }
     cmp!(lt, _CMP_LT_OQ);
     cmp!(le, _CMP_LE_OQ);
     cmp!(eq, _CMP_EQ_OQ);
@@ -157,6 +193,18 @@ impl Vector<WIDTH> for Y2 {
     #[inline(always)]
     fn abs(self) -> Self {
         Y2(self.0.abs(), self.1.abs())
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Y2(self.0.sqrt(), self.1.sqrt())
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Y2(self.0.neg(), self.1.neg())
+    }
+    #[inline(always)]
+    fn next_f32(self, up: u32) -> Self {
+        Y2(self.0.next_f32(up & 0xff), self.1.next_f32(up >> 8))
     }
     both_cmp!(lt);
     both_cmp!(le);

@@ -68,6 +68,45 @@ impl Vector<WIDTH> for Z {
     fn abs(self) -> Self {
         unsafe { Z(_mm512_abs_ps(self.0)) }
     }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        unsafe { Z(_mm512_sqrt_ps(self.0)) }
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        // avx512f has no xor_ps (that is avx512dq): flip the sign bit as integers.
+        unsafe {
+            Z(_mm512_castsi512_ps(_mm512_xor_si512(
+                _mm512_castps_si512(self.0),
+                _mm512_set1_epi32(i32::MIN),
+            )))
+        }
+    }
+    /// As the AVX2 path, on k-masks.
+    #[inline(always)]
+    fn next_f32(self, up: u32) -> Self {
+        unsafe {
+            let bits = _mm512_castps_si512(self.0);
+            let up = up as __mmask16;
+            let abs = _mm512_and_si512(bits, _mm512_set1_epi32(0x7fff_ffff));
+            let neg = _mm512_cmplt_epi32_mask(bits, _mm512_setzero_si512());
+            let away = neg ^ up;
+            let one = _mm512_set1_epi32(1);
+            let stepped = _mm512_mask_blend_epi32(
+                away,
+                _mm512_sub_epi32(bits, one),
+                _mm512_add_epi32(bits, one),
+            );
+            let from_zero =
+                _mm512_mask_blend_epi32(up, _mm512_set1_epi32(0x8000_0001u32 as i32), one);
+            let zero = _mm512_cmpeq_epi32_mask(abs, _mm512_setzero_si512());
+            let r = _mm512_mask_blend_epi32(zero, stepped, from_zero);
+            let inf = _mm512_set1_epi32(0x7f80_0000);
+            let stays =
+                _mm512_cmpgt_epi32_mask(abs, inf) | (_mm512_cmpeq_epi32_mask(abs, inf) & away);
+            Z(_mm512_castsi512_ps(_mm512_mask_blend_epi32(stays, r, bits)))
+        }
+    }
     cmp!(lt, _CMP_LT_OQ);
     cmp!(le, _CMP_LE_OQ);
     cmp!(eq, _CMP_EQ_OQ);

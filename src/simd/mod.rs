@@ -12,8 +12,10 @@ mod avx2;
 mod avx512;
 mod isa;
 mod portable;
+mod vec3;
 
 pub use isa::Isa;
+pub use vec3::{Soa3, V3};
 
 /// Lane count of a packet: one 4×4 pixel tile (see the assertion in `tracer`).
 pub const WIDTH: usize = 16;
@@ -38,6 +40,13 @@ pub trait Vector<const N: usize>: Copy {
     /// `if a > b { a } else { b }` per lane (MAXPS semantics).
     fn max(self, o: Self) -> Self;
     fn abs(self) -> Self;
+    /// The correctly rounded square root (IEEE, so every ISA agrees).
+    fn sqrt(self) -> Self;
+    /// The sign bit flipped (`-x`, so -0.0 for 0.0: not `0 - x`).
+    fn neg(self) -> Self;
+    /// Per lane, the next f32 up (bit i of `up` set) or down: [`crate::math::next_f32`] bit for
+    /// bit, NaN and infinities included.
+    fn next_f32(self, up: u32) -> Self;
     /// Ordered comparisons (false on NaN).
     fn lt(self, o: Self) -> u32;
     fn le(self, o: Self) -> u32;
@@ -60,7 +69,9 @@ pub trait Lanes: Copy {
     type W: Vector<NARROW>;
 }
 
-/// A computation generic over the lane types; [`run`] instantiates it for one ISA.
+/// A computation generic over the lane types; [`run`] instantiates it for one ISA. Mark `run`
+/// (and every function it calls on lanes) `#[inline(always)]`: only code inlined into the ISA's
+/// `#[target_feature]` entry is compiled for it, and an intrinsic outside it is a call.
 pub trait Kernel {
     type Out;
     fn run<L: Lanes>(self) -> Self::Out;
@@ -101,6 +112,10 @@ mod tests {
             x.min(y),
             x.max(y),
             x.abs(),
+            x.abs().sqrt(),
+            x.neg(),
+            x.next_f32(0b0110_1001_0011_1100 & ((1u64 << N) - 1) as u32),
+            y.next_f32(!0b0110_1001_0011_1100 & ((1u64 << N) - 1) as u32),
             V::select(0b1010_0101_1100_0011 & ((1u64 << N) - 1) as u32, x, y),
             V::splat(a[1]),
             V::splat(x.reduce_min()),
@@ -160,7 +175,7 @@ mod tests {
         let want = run(Isa::Portable, Probe(a, b));
         assert_eq!(want[0].1[2].count_ones(), 6);
         assert_eq!(want[0].1[3] & 0b1000, 0b1000, "-0.0 has its sign bit");
-        assert_eq!(want[0].0[9][0], -9.5, "reduce_min");
+        assert_eq!(want[0].0[13][0], -9.5, "reduce_min");
         for isa in Isa::available() {
             let got = run(isa, Probe(a, b));
             for (g, w) in got.iter().zip(&want) {
@@ -172,6 +187,58 @@ mod tests {
                     assert_eq!(x, y, "{isa:?}");
                 }
                 assert_eq!(g.1, w.1, "{isa:?}");
+            }
+        }
+    }
+
+    struct Step<'a>(&'a [f32], u32);
+
+    impl Kernel for Step<'_> {
+        type Out = Vec<u32>;
+        fn run<L: Lanes>(self) -> Vec<u32> {
+            let mut out = Vec::new();
+            for c in self.0.chunks_exact(WIDTH) {
+                let mut o = [0.0; WIDTH];
+                L::V::load(c.try_into().unwrap())
+                    .next_f32(self.1)
+                    .store(&mut o);
+                out.extend(o.map(f32::to_bits));
+            }
+            out
+        }
+    }
+
+    /// The lanes' `next_f32` is `math::next_f32` on every ISA: zeros, subnormals, extremes,
+    /// infinities, NaN and a spread of bit patterns, each lane up or down by its mask bit.
+    #[test]
+    fn lane_next_f32_is_the_scalar_one() {
+        let mut xs = vec![
+            0.0f32,
+            -0.0,
+            f32::from_bits(1),
+            -f32::from_bits(1),
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+            1.0,
+            -1.0,
+            f32::from_bits(0x7f7f_ffff),
+            f32::from_bits(0x8000_0002),
+            3.5,
+        ];
+        xs.extend((0..4096u64).map(|i| f32::from_bits((crate::math::mix64(i) >> 32) as u32)));
+        for up in [0xffff, 0, 0b1010_0110_0101_1001, 0b0101_1001_1010_0110] {
+            let want: Vec<u32> = xs
+                .iter()
+                .enumerate()
+                .map(|(i, &x)| crate::math::next_f32(x, up >> (i % WIDTH) & 1 != 0).to_bits())
+                .collect();
+            for isa in Isa::available() {
+                assert_eq!(run(isa, Step(&xs, up)), want, "{isa:?} up={up:#x}");
             }
         }
     }

@@ -71,6 +71,20 @@ impl<const N: usize> Vector<N> for P<N> {
         P(self.0.map(f32::abs))
     }
     #[inline(always)]
+    fn sqrt(self) -> Self {
+        P(self.0.map(f32::sqrt))
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        P(self.0.map(|x| -x))
+    }
+    #[inline(always)]
+    fn next_f32(self, up: u32) -> Self {
+        P(std::array::from_fn(|i| {
+            crate::math::next_f32(self.0[i], up >> i & 1 != 0)
+        }))
+    }
+    #[inline(always)]
     fn lt(self, o: Self) -> u32 {
         self.bits(o, |x, y| x < y)
     }

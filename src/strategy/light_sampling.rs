@@ -5,10 +5,15 @@
 
 use super::{Estimator, Integrand, Probes, ShadingPoint, ShadowProbe, Strategy, env_method_name};
 use crate::env::EnvMethod;
+use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
+use crate::lights::{LaneQuery, LaneSamples, SHADOW_EPSILON, selection_number};
 use crate::lights::{LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride};
+use crate::math::offset_ray_origin_lanes;
 use crate::prepare::SceneView;
 use crate::sampling::{Dimension, Dims, Layout};
+use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, WIDTH};
+use crate::tracer::LANES;
 use glam::Vec3;
 
 /// The light-sampling part of a layout: which light, where on it, and a third number for
@@ -77,6 +82,78 @@ pub struct BoundLights<'s> {
     pub lights: &'s LightSet,
     pub selector: &'s dyn LightSelector,
     pub methods: LightMethods,
+    /// The lane layer's instruction set for [`Self::probe_packet`] (every ISA gives the same
+    /// bits; `DIBENCH_ISA` picks one).
+    pub isa: Isa,
+}
+
+/// What [`BoundLights::probe`] returns for one shading point: the shadow probe with its
+/// unweighted value, the light sample (pdf with the selection's), its direction in the shading
+/// frame, and the light's index.
+pub type LightProbe = (ShadowProbe, LightSample, Vec3, usize);
+
+/// The packet's per-lane inputs to the shadow-ray kernel, beside the light samples.
+#[derive(Default)]
+struct ShadowLanes {
+    pmf: [f32; WIDTH],
+    origin: Soa3,
+    s: Soa3,
+    t: Soa3,
+}
+
+/// The shadow-ray kernel's results: `valid` lanes have a probe.
+#[derive(Default)]
+struct ShadowRays {
+    valid: u32,
+    dir: Soa3,
+    tmax: [f32; WIDTH],
+    local: Soa3,
+    pdf: [f32; WIDTH],
+    /// cos θ / pdf, the factor of f·L in the estimate.
+    factor: [f32; WIDTH],
+}
+
+/// The rest of [`BoundLights::probe`] after the light sample, over lanes: the cosine, the
+/// shadow segment ([`LightSample::shadow_ray`]), the direction in the shading frame, the pdf
+/// with the selection's and cos θ / pdf, in the scalar code's operations and order.
+#[inline(always)]
+fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLanes) -> ShadowRays {
+    let zero = V::splat(0.0);
+    let wi = V3::<V>::load(&ls.wi);
+    let pdf = V::load(&ls.pdf).mul(V::load(&x.pmf));
+    let cos = V3::load(&q.n).dot(wi);
+    let mut valid = ls.valid & !cos.le(zero);
+    let origin = V3::load(&x.origin);
+    let point = V3::load(&ls.point);
+    let normal = V3::load(&ls.normal);
+    let facing = zero.le(normal.dot(origin - point));
+    let towards = V3::select(facing, normal, -normal);
+    let target = offset_ray_origin_lanes(point, V3::load(&ls.point_error), towards);
+    let d = target - origin;
+    let dist = d.dot(d).sqrt();
+    let distant = ls.distant;
+    valid &= distant | !dist.eq(zero);
+    let dir = V3::select(distant, wi, d / dist);
+    let tmax = V::select(
+        distant,
+        V::splat(f32::INFINITY),
+        dist.mul(V::splat(1.0 - SHADOW_EPSILON)),
+    );
+    let local = V3 {
+        x: wi.dot(V3::load(&x.s)),
+        y: wi.dot(V3::load(&x.t)),
+        z: cos,
+    };
+    let mut out = ShadowRays {
+        valid,
+        ..ShadowRays::default()
+    };
+    dir.store(&mut out.dir);
+    tmax.store(&mut out.tmax);
+    local.store(&mut out.local);
+    pdf.store(&mut out.pdf);
+    cos.div(pdf).store(&mut out.factor);
+    out
 }
 
 impl<'s> BoundLights<'s> {
@@ -90,6 +167,7 @@ impl<'s> BoundLights<'s> {
         let selector = scene.lights.selector(selector)?;
         Ok(BoundLights {
             lights: scene.lights,
+            isa: Isa::detect().unwrap_or(Isa::Portable),
             selector,
             methods: scene
                 .lights
@@ -101,11 +179,7 @@ impl<'s> BoundLights<'s> {
     /// The light-sampled part of an estimate (shared with MIS): the unweighted value
     /// f·L·cos/pdf with its shadow ray, the light sample (its direction also in the shading
     /// frame) and the light's index; or None.
-    pub fn probe(
-        &self,
-        sp: &ShadingPoint,
-        u: &mut Dims,
-    ) -> Option<(ShadowProbe, LightSample, Vec3, usize)> {
+    pub fn probe(&self, sp: &ShadingPoint, u: &mut Dims) -> Option<LightProbe> {
         let u_select = u.get_1d();
         let ul = u.get_3d();
         let (light, ls) =
@@ -119,6 +193,85 @@ impl<'s> BoundLights<'s> {
         let local = sp.bsdf.to_local(ls.wi);
         let value = sp.bsdf.eval_local(local) * ls.radiance * (cos / ls.pdf);
         Some((ShadowProbe { ray, value }, ls, local, light))
+    }
+
+    /// [`Self::probe`] for a packet of shading points, bit for bit: the lights are chosen lane
+    /// by lane, each chosen light samples its lanes at once ([`Light::sample_lanes`]), and the
+    /// shadow segments, cosines and pdfs are computed over lanes; only f is evaluated lane by
+    /// lane. Lanes without a point are left as they are.
+    pub fn probe_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        u: &mut [Dims; LANES],
+        out: &mut [Option<LightProbe>; LANES],
+    ) {
+        let mut q = LaneQuery::default();
+        let mut x = ShadowLanes::default();
+        let mut light = [usize::MAX; LANES];
+        for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
+            let Some(sp) = sp else { continue };
+            out[lane] = None;
+            let u_select = u.get_1d();
+            let ul = u.get_3d();
+            let ctx = sp.light_ctx();
+            let Some((i, pmf)) = self
+                .selector
+                .sample(&ctx, selection_number(u_select, ul[2]))
+            else {
+                continue;
+            };
+            light[lane] = i;
+            x.pmf[lane] = pmf;
+            q.active |= 1 << lane;
+            q.p.set(lane, ctx.p);
+            q.n.set(lane, ctx.n);
+            for (k, &v) in ul.iter().enumerate() {
+                q.u[k][lane] = v;
+            }
+            x.origin.set(lane, sp.origin);
+            x.s.set(lane, sp.bsdf.frame.s);
+            x.t.set(lane, sp.bsdf.frame.t);
+        }
+        // Each chosen light samples its lanes at once.
+        let mut ls = LaneSamples::default();
+        let mut rest = q.active;
+        while rest != 0 {
+            let i = light[rest.trailing_zeros() as usize];
+            let mut mask = 0;
+            for (lane, &l) in light.iter().enumerate() {
+                if l == i {
+                    mask |= 1 << lane;
+                }
+            }
+            rest &= !mask;
+            let group = LaneQuery { active: mask, ..q };
+            self.lights
+                .get(i)
+                .sample_lanes(self.isa, &group, &self.methods, &mut ls);
+        }
+        struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes);
+        impl simd::Kernel for Kernel<'_> {
+            type Out = ShadowRays;
+            #[inline(always)]
+            fn run<L: Lanes>(self) -> ShadowRays {
+                shadow_lanes::<L::V>(self.0, self.1, self.2)
+            }
+        }
+        let r = simd::run(self.isa, Kernel(&q, &ls, &x));
+        for (lane, sp) in points.iter().enumerate() {
+            let Some(sp) = sp else { continue };
+            if r.valid >> lane & 1 == 0 {
+                continue;
+            }
+            let local = r.local.get(lane);
+            let mut sample = ls
+                .get(lane)
+                .expect("a valid shadow lane has a light sample");
+            sample.pdf = r.pdf[lane];
+            let value = sp.bsdf.eval_local(local) * sample.radiance * r.factor[lane];
+            let ray = Ray::new(sp.origin, r.dir.get(lane), r.tmax[lane]);
+            out[lane] = Some((ShadowProbe { ray, value }, sample, local, light[lane]));
+        }
     }
 
     /// The pdf with which [`Self::probe`] samples the direction to point `q` of part `local`
@@ -231,6 +384,24 @@ impl Estimator for LightEstimator<'_> {
         match self.0.probe(sp, u) {
             Some((p, ..)) => Probes::shadow(p),
             None => Probes::default(),
+        }
+    }
+
+    fn sample_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        u: &mut [Dims; LANES],
+        out: &mut [Probes; LANES],
+    ) {
+        let mut probes = [None; LANES];
+        self.0.probe_packet(points, u, &mut probes);
+        for ((o, p), sp) in out.iter_mut().zip(probes).zip(points) {
+            if sp.is_some() {
+                *o = match p {
+                    Some((p, ..)) => Probes::shadow(p),
+                    None => Probes::default(),
+                };
+            }
         }
     }
 }

@@ -6,7 +6,7 @@
 //! samples, follow the strategy's [`BsdfSampling`] part (lobe selection, GGX sampler).
 
 use super::direction::{BSDF_DIMS, emission_probe_with};
-use super::light_sampling::{BoundLights, LIGHT_DIMS, selector_applies, with_selector};
+use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
 use super::{EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, Strategy, env_method_name};
 use crate::bsdf::BsdfSampling;
 use crate::env::EnvMethod;
@@ -14,6 +14,7 @@ use crate::lights::selector::{SelectorType, default_selector};
 use crate::lights::{LightMethods, LightShape};
 use crate::prepare::{SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout};
+use crate::tracer::LANES;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Heuristic {
@@ -227,27 +228,47 @@ struct MisEstimator<'s> {
     lights: BoundLights<'s>,
 }
 
+impl MisEstimator<'_> {
+    /// The sample after its light probe: the probe's MIS weight, then the BSDF sample.
+    fn finish(&self, sp: &ShadingPoint, light: Option<LightProbe>, u: &mut Dims) -> Probes {
+        let h = self.strategy.heuristic;
+        let sampling = self.strategy.sampling;
+        let shadow = light.map(|(mut probe, ls, local, light)| {
+            // A delta light is reachable by light sampling only: its weight is 1.
+            if !self.lights.lights.get(light).is_delta() {
+                probe.value *= h.weight(ls.pdf, sp.bsdf.pdf_local(local, sampling));
+            }
+            probe
+        });
+        let bs = sp.bsdf.sample(u.get_3d(), sampling);
+        let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
+        Probes { shadow, emission }
+    }
+}
+
 impl Estimator for MisEstimator<'_> {
     fn layout(&self) -> Layout {
         Layout::of(&LIGHT_DIMS).then(Layout::of(&BSDF_DIMS))
     }
 
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
-        let h = self.strategy.heuristic;
-        let sampling = self.strategy.sampling;
-        let shadow = self
-            .lights
-            .probe(sp, u)
-            .map(|(mut probe, ls, local, light)| {
-                // A delta light is reachable by light sampling only: its weight is 1.
-                if !self.lights.lights.get(light).is_delta() {
-                    probe.value *= h.weight(ls.pdf, sp.bsdf.pdf_local(local, sampling));
-                }
-                probe
-            });
-        let bs = sp.bsdf.sample(u.get_3d(), sampling);
-        let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
-        Probes { shadow, emission }
+        let light = self.lights.probe(sp, u);
+        self.finish(sp, light, u)
+    }
+
+    fn sample_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        u: &mut [Dims; LANES],
+        out: &mut [Probes; LANES],
+    ) {
+        let mut light = [None; LANES];
+        self.lights.probe_packet(points, u, &mut light);
+        for (((o, sp), u), light) in out.iter_mut().zip(points).zip(u).zip(light) {
+            if let Some(sp) = sp {
+                *o = self.finish(sp, light, u);
+            }
+        }
     }
 
     fn emission_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe, hit: &SurfaceHit) -> f32 {

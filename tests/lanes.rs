@@ -1,0 +1,208 @@
+//! The sample path over lanes (#19 part B) against the scalar path it replaces: for shading
+//! points the camera sees in every built-in scene with lights of every shape, a packet's light
+//! probes ([`BoundLights::probe_packet`], on every ISA) and an estimator's packet of probes
+//! ([`Estimator::sample_packet`]) must equal the scalar ones lane by lane, bit for bit, and
+//! consume the same sample dimensions.
+
+use dibench::lights::selector::default_selector;
+use dibench::lights::{LightMethods, MethodOverride};
+use dibench::prepare::PreparedScene;
+use dibench::render::camera_ray;
+use dibench::sampling::Dims;
+use dibench::sampling::stream::SampleStream;
+use dibench::scene::Scene;
+use dibench::simd::Isa;
+use dibench::strategy::light_sampling::{BoundLights, LightProbe};
+use dibench::strategy::{Probes, ShadingPoint, by_name};
+use dibench::tracer::LANES;
+
+/// Scenes with quad, sphere, mesh, point, spot, directional and environment lights.
+const SCENES: [&str; 6] = [
+    "cornell",
+    "bunny",
+    "sphere_light",
+    "mesh_light",
+    "spot_directional",
+    "env_venice_bunny",
+];
+
+/// A floor under a rectangle light whose edges have no zero component, so every lane
+/// operation's rounding shows (the built-in quads are axis-aligned or tilted about one axis).
+const TILTED: &str = r#"
+[camera]
+eye = [0.3, 1.2, 4.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y_deg = 50.0
+[image]
+width = 32
+height = 32
+[[material]]
+name = "floor"
+albedo = [0.6, 0.5, 0.4]
+[[material]]
+name = "lamp"
+albedo = [0.0, 0.0, 0.0]
+[[quad]]
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "floor"
+[[quad]]
+corner = [-0.3, 1.5, 0.1]
+edge_u = [0.4, 0.2, 0.4]
+edge_v = [-0.3333333, 0.3333333, 0.16666667]
+material = "lamp"
+emission = [3.0, 2.0, 1.0]
+"#;
+
+fn scenes() -> Vec<(String, PreparedScene)> {
+    let mut v: Vec<(String, PreparedScene)> = SCENES
+        .iter()
+        .map(|&name| {
+            let path = Scene::resolve(name).unwrap();
+            (
+                name.to_string(),
+                PreparedScene::new(Scene::load(&path).unwrap()),
+            )
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Scene::parse(TILTED, &dir.path().join("tilted.toml")).unwrap();
+    v.push(("tilted".into(), PreparedScene::new(scene)));
+    v
+}
+
+const DIMS: usize = 16;
+
+/// Packets of shading points seen through random pixels, with lane 5 of every packet and
+/// every lane whose camera ray misses left empty; and sample values for every lane.
+fn packets(
+    scene: &PreparedScene,
+    count: usize,
+) -> Vec<([Option<ShadingPoint<'_>>; LANES], Vec<f32>)> {
+    let (w, h) = (scene.scene.width, scene.scene.height);
+    let mut rng = SampleStream::new(7, 0x1a_4e5, 0, 0);
+    let mut f = move || rng.next_1d();
+    (0..count)
+        .map(|_| {
+            let points = std::array::from_fn(|lane| {
+                if lane == 5 {
+                    return None;
+                }
+                let (x, y) = ((f() * w as f32) as u32 % w, (f() * h as f32) as u32 % h);
+                let ray = camera_ray(&scene.scene.camera, w, h, x, y, [f(), f()]);
+                let hit = scene.tracer.intersect(&ray)?;
+                let s = scene.world.surface(&ray, &hit);
+                Some(ShadingPoint::with_error(
+                    s.p,
+                    s.p_error,
+                    s.ng,
+                    ray.dir,
+                    &scene.world.materials[s.material as usize],
+                ))
+            });
+            (points, (0..LANES * DIMS).map(|_| f()).collect())
+        })
+        .collect()
+}
+
+fn dims(values: &[f32]) -> [Dims<'_>; LANES] {
+    std::array::from_fn(|lane| Dims::new(&values[lane * DIMS..(lane + 1) * DIMS]))
+}
+
+/// Debug text prints every float by its shortest round trip, so equal text is equal bits.
+fn same<T: std::fmt::Debug>(a: &T, b: &T) -> bool {
+    format!("{a:?}") == format!("{b:?}")
+}
+
+#[test]
+fn light_probes_over_lanes_are_the_scalar_ones() {
+    let mut checked = 0;
+    let mut with_probe = 0;
+    for (name, scene) in scenes() {
+        let view = scene.view(dibench::strategy::Integrand::DIRECT);
+        let packets = packets(&scene, 48);
+        let mut sets = vec![LightMethods::BASIC, LightMethods::SOLID_ANGLE];
+        sets.extend(
+            MethodOverride::all()
+                .into_iter()
+                .map(|o| o.apply(LightMethods::BASIC)),
+        );
+        for methods in sets {
+            let strategy = format!("{methods:?}");
+            let mut bound = BoundLights::bind(&view, default_selector(), methods).unwrap();
+            for isa in Isa::available() {
+                bound.isa = isa;
+                for (points, values) in &packets {
+                    let mut want: [Option<LightProbe>; LANES] = [None; LANES];
+                    let mut u = dims(values);
+                    for lane in 0..LANES {
+                        if let Some(sp) = &points[lane] {
+                            want[lane] = bound.probe(sp, &mut u[lane]);
+                        }
+                    }
+                    let next_want: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
+                    let mut got: [Option<LightProbe>; LANES] = [None; LANES];
+                    let mut u = dims(values);
+                    bound.probe_packet(points, &mut u, &mut got);
+                    let next_got: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
+                    assert_eq!(
+                        next_got, next_want,
+                        "{name} {strategy} {isa:?}: dimensions read"
+                    );
+                    for lane in 0..LANES {
+                        assert!(
+                            same(&got[lane], &want[lane]),
+                            "{name} {strategy} {isa:?} lane {lane}:\n got {:?}\nwant {:?}",
+                            got[lane],
+                            want[lane]
+                        );
+                        checked += points[lane].is_some() as usize;
+                        with_probe += want[lane].is_some() as usize;
+                    }
+                }
+            }
+        }
+    }
+    // The comparison is not vacuous: most points get a probe.
+    assert!(
+        checked > 4000 && with_probe > checked / 3,
+        "{checked} {with_probe}"
+    );
+}
+
+#[test]
+fn estimators_packets_are_their_samples() {
+    for (name, scene) in scenes() {
+        let packets = packets(&scene, 24);
+        for strategy in ["light", "mis-power", "mis-power-area", "mis-balance"] {
+            let s = by_name(strategy).unwrap();
+            let Ok(est) = s.bind(scene.view(s.integrand())) else {
+                continue;
+            };
+            for (points, values) in &packets {
+                let mut want = [Probes::default(); LANES];
+                let mut u = dims(values);
+                for lane in 0..LANES {
+                    if let Some(sp) = &points[lane] {
+                        want[lane] = est.sample(sp, &mut u[lane]);
+                    }
+                }
+                let next_want: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
+                let mut got = [Probes::default(); LANES];
+                let mut u = dims(values);
+                est.sample_packet(points, &mut u, &mut got);
+                let next_got: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
+                assert_eq!(next_got, next_want, "{name} {strategy}: dimensions read");
+                for lane in 0..LANES {
+                    assert!(
+                        same(&got[lane], &want[lane]),
+                        "{name} {strategy} lane {lane}:\n got {:?}\nwant {:?}",
+                        got[lane],
+                        want[lane]
+                    );
+                }
+            }
+        }
+    }
+}
