@@ -287,8 +287,6 @@ impl LightMethods {
 /// arrays): what [`LightCtx`] and the three sample numbers are per lane.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct LaneQuery {
-    /// Lanes to sample (bit i = lane i).
-    pub active: u32,
     pub p: Soa3,
     pub n: Soa3,
     /// `u[k][lane]`: the sample numbers [`Light::sample`] takes.
@@ -359,11 +357,12 @@ impl LaneSamples {
 pub fn sample_lane_by_lane<T: Light + ?Sized>(
     light: &T,
     q: &LaneQuery,
+    active: u32,
     m: &LightMethods,
     out: &mut LaneSamples,
 ) {
     for lane in 0..WIDTH {
-        if q.active >> lane & 1 != 0 {
+        if active >> lane & 1 != 0 {
             let u = [q.u[0][lane], q.u[1][lane], q.u[2][lane]];
             out.set(lane, light.sample(&q.ctx(lane), u, m));
         }
@@ -475,12 +474,19 @@ pub trait Light: Send + Sync + std::fmt::Debug {
     /// one-sided emitter).
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample>;
 
-    /// [`Self::sample`] for the lanes of `q.active` at once, on the lane layer's `isa`: lane i
-    /// of `out` is what [`Self::sample`] returns for lane i, bit for bit (lanes outside
-    /// `q.active` are left as they were). The default samples lane by lane; a light with a
+    /// [`Self::sample`] for the lanes of `active` (bit i = lane i) at once, on the lane layer's
+    /// `isa`: lane i of `out` is what [`Self::sample`] returns for lane i, bit for bit (other
+    /// lanes are left as they were). The default samples lane by lane; a light with a
     /// kernel over lanes overrides it for the methods the kernel covers (#19 part B).
-    fn sample_lanes(&self, _isa: Isa, q: &LaneQuery, m: &LightMethods, out: &mut LaneSamples) {
-        sample_lane_by_lane(self, q, m, out)
+    fn sample_lanes(
+        &self,
+        _isa: Isa,
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        out: &mut LaneSamples,
+    ) {
+        sample_lane_by_lane(self, q, active, m, out)
     }
 
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to

@@ -61,10 +61,10 @@ impl QuadLight {
         })
     }
 
-    /// [`Self::sample_area`] for the lanes of `q.active` (u = `q.u[0..2]`), the same operations
+    /// [`Self::sample_area`] for the lanes of `a` (u = `q.u[0..2]`), the same operations
     /// in the same order over lanes; other lanes of `out` are kept.
     #[inline(always)]
-    fn sample_area_lanes<V: Vector<WIDTH>>(&self, q: &LaneQuery, out: &mut LaneSamples) {
+    fn sample_area_lanes<V: Vector<WIDTH>>(&self, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
         let zero = V::splat(0.0);
         let (u0, u1) = (V::load(&q.u[0]), V::load(&q.u[1]));
         let eu = V3::splat(self.edge_u).scale(u0);
@@ -75,10 +75,9 @@ impl QuadLight {
         let d2 = d.dot(d);
         let wi = d / d2.sqrt();
         let cos_l = V3::splat(self.normal).dot(wi).neg();
-        let valid = q.active & zero.lt(d2) & !cos_l.le(zero);
+        let valid = a & zero.lt(d2) & !cos_l.le(zero);
         let error = (V3::splat(self.corner.abs()) + eu.abs() + ev.abs()).scale(V::splat(gamma(6)));
         let pdf = d2.div(V::splat(self.area).mul(cos_l));
-        let a = q.active;
         keep(a, wi, &mut out.wi);
         keep(a, point, &mut out.point);
         keep(a, V3::<V>::splat(self.normal), &mut out.normal);
@@ -194,18 +193,25 @@ impl Light for QuadLight {
         }
     }
 
-    fn sample_lanes(&self, isa: Isa, q: &LaneQuery, m: &LightMethods, out: &mut LaneSamples) {
-        struct Area<'a>(&'a QuadLight, &'a LaneQuery, &'a mut LaneSamples);
+    fn sample_lanes(
+        &self,
+        isa: Isa,
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        out: &mut LaneSamples,
+    ) {
+        struct Area<'a>(&'a QuadLight, &'a LaneQuery, u32, &'a mut LaneSamples);
         impl Kernel for Area<'_> {
             type Out = ();
             #[inline(always)]
             fn run<L: Lanes>(self) {
-                self.0.sample_area_lanes::<L::V>(self.1, self.2)
+                self.0.sample_area_lanes::<L::V>(self.1, self.2, self.3)
             }
         }
         match m.quad {
-            QuadMethod::Area => simd::run(isa, Area(self, q, out)),
-            QuadMethod::SolidAngle => sample_lane_by_lane(self, q, m, out),
+            QuadMethod::Area => simd::run(isa, Area(self, q, active, out)),
+            QuadMethod::SolidAngle => sample_lane_by_lane(self, q, active, m, out),
         }
     }
 

@@ -208,6 +208,7 @@ impl<'s> BoundLights<'s> {
         let mut q = LaneQuery::default();
         let mut x = ShadowLanes::default();
         let mut light = [usize::MAX; LANES];
+        let mut chosen = 0u32;
         for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
             let Some(sp) = sp else { continue };
             out[lane] = None;
@@ -222,7 +223,7 @@ impl<'s> BoundLights<'s> {
             };
             light[lane] = i;
             x.pmf[lane] = pmf;
-            q.active |= 1 << lane;
+            chosen |= 1 << lane;
             q.p.set(lane, ctx.p);
             q.n.set(lane, ctx.n);
             for (k, &v) in ul.iter().enumerate() {
@@ -234,7 +235,7 @@ impl<'s> BoundLights<'s> {
         }
         // Each chosen light samples its lanes at once.
         let mut ls = LaneSamples::default();
-        let mut rest = q.active;
+        let mut rest = chosen;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
             let mut mask = 0;
@@ -244,10 +245,9 @@ impl<'s> BoundLights<'s> {
                 }
             }
             rest &= !mask;
-            let group = LaneQuery { active: mask, ..q };
             self.lights
                 .get(i)
-                .sample_lanes(self.isa, &group, &self.methods, &mut ls);
+                .sample_lanes(self.isa, &q, mask, &self.methods, &mut ls);
         }
         struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes);
         impl simd::Kernel for Kernel<'_> {
