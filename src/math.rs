@@ -22,6 +22,25 @@ impl Frame {
         Frame { s, t, n }
     }
 
+    /// [`Self::from_normal`] over lanes, bit for bit: the (s, t) of each lane's unit normal.
+    #[inline(always)]
+    pub fn from_normal_lanes<V: Vector<WIDTH>>(n: V3<V>) -> (V3<V>, V3<V>) {
+        let sign = V::select(n.z.sign(), V::splat(-1.0), V::splat(1.0));
+        let a = V::splat(-1.0).div(sign.add(n.z));
+        let b = n.x.mul(n.y).mul(a);
+        let s = V3 {
+            x: V::splat(1.0).add(sign.mul(n.x).mul(n.x).mul(a)),
+            y: sign.mul(b),
+            z: sign.neg().mul(n.x),
+        };
+        let t = V3 {
+            x: b,
+            y: sign.add(n.y.mul(n.y).mul(a)),
+            z: n.y.neg(),
+        };
+        (s, t)
+    }
+
     pub fn to_world(&self, v: Vec3) -> Vec3 {
         self.s * v.x + self.t * v.y + self.n * v.z
     }

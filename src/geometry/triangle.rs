@@ -3,6 +3,7 @@
 //! triangles sharing it, so light cannot leak through the seams of a mesh or a two-triangle quad.
 
 use super::Ray;
+use crate::simd::{V3, Vector, WIDTH};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -164,6 +165,17 @@ impl Triangle {
     pub fn point_error(&self, b1: f32, b2: f32) -> Vec3 {
         let b0 = 1.0 - b1 - b2;
         crate::math::gamma(7) * ((self.v0 * b0).abs() + (self.v1 * b1).abs() + (self.v2 * b2).abs())
+    }
+
+    /// [`Self::point`] and [`Self::point_error`] over lanes, bit for bit, for each lane's
+    /// triangle (v0, v1, v2) and barycentrics (b1, b2).
+    #[inline(always)]
+    pub fn point_lanes<V: Vector<WIDTH>>(v: [V3<V>; 3], b1: V, b2: V) -> (V3<V>, V3<V>) {
+        let b0 = V::splat(1.0).sub(b1).sub(b2);
+        let (a, b, c) = (v[0].scale(b0), v[1].scale(b1), v[2].scale(b2));
+        let p = a + b + c;
+        let error = (a.abs() + b.abs() + c.abs()).scale(V::splat(crate::math::gamma(7)));
+        (p, error)
     }
 
     /// Two-sided intersection in (0, ray.tmax).

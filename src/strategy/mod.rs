@@ -18,9 +18,10 @@ use crate::bsdf::{Bsdf, LocalBsdf};
 use crate::env::{EnvMethod, EnvSampler, Repr};
 use crate::geometry::Ray;
 use crate::lights::LightCtx;
-use crate::math::{Frame, offset_ray_origin};
+use crate::math::{Frame, offset_ray_origin, offset_ray_origin_lanes};
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout};
+use crate::simd::{Soa3, V3, Vector, WIDTH};
 use crate::tracer::LANES;
 use glam::Vec3;
 
@@ -66,12 +67,68 @@ impl<'a> ShadingPoint<'a> {
         }
     }
 
+    /// A shading point of lane `lane` of [`ShadingLanes`] (as [`Self::with_error`] makes it).
+    pub fn from_lanes(g: &ShadingLanes, lane: usize, p: Vec3, bsdf: &'a Bsdf) -> Self {
+        let n = g.n.get(lane);
+        ShadingPoint {
+            p,
+            origin: g.origin.get(lane),
+            n,
+            wo: g.wo.get(lane),
+            bsdf: LocalBsdf {
+                frame: Frame {
+                    s: g.s.get(lane),
+                    t: g.t.get(lane),
+                    n,
+                },
+                wo: g.wo_local.get(lane),
+                bsdf,
+            },
+            pixel: u32::MAX,
+        }
+    }
+
     /// What a light sampler or selector is told about this point.
     pub fn light_ctx(&self) -> LightCtx {
         LightCtx {
             p: self.p,
             n: self.n,
         }
+    }
+}
+
+/// The geometry [`ShadingPoint::with_error`] derives, for 16 lanes: the normal flipped to the
+/// viewer, its frame, the direction to the viewer (world and local) and the offset origin.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ShadingLanes {
+    pub n: Soa3,
+    pub s: Soa3,
+    pub t: Soa3,
+    pub wo: Soa3,
+    pub wo_local: Soa3,
+    pub origin: Soa3,
+}
+
+impl ShadingLanes {
+    /// [`ShadingPoint::with_error`] over lanes, bit for bit.
+    #[inline(always)]
+    pub fn compute<V: Vector<WIDTH>>(p: V3<V>, p_error: V3<V>, ng: V3<V>, view_dir: V3<V>) -> Self {
+        let n = V3::select(ng.dot(view_dir).lt(V::splat(0.0)), ng, -ng);
+        let (s, t) = Frame::from_normal_lanes(n);
+        let wo = -view_dir;
+        let wo_local = V3 {
+            x: wo.dot(s),
+            y: wo.dot(t),
+            z: wo.dot(n),
+        };
+        let mut g = ShadingLanes::default();
+        n.store(&mut g.n);
+        s.store(&mut g.s);
+        t.store(&mut g.t);
+        wo.store(&mut g.wo);
+        wo_local.store(&mut g.wo_local);
+        offset_ray_origin_lanes(p, p_error, n).store(&mut g.origin);
+        g
     }
 }
 
