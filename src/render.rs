@@ -280,7 +280,7 @@ impl<'a> Renderer<'a> {
             return;
         }
         let (p, p_error, geo) = simd::run(self.isa, ShadingKernel(&g, &cam));
-        for lane in 0..LANES {
+        for (lane, &pixel) in pixels.iter().enumerate() {
             if hit_mask & (1 << lane) == 0 {
                 continue;
             }
@@ -300,7 +300,7 @@ impl<'a> Renderer<'a> {
             }
             let mut sp =
                 ShadingPoint::from_lanes(&geo, lane, p, &world.materials[material as usize]);
-            sp.pixel = pixels[lane];
+            sp.pixel = pixel;
             out.points[lane] = Some(sp);
         }
     }
