@@ -4,7 +4,7 @@
 //! draws — the assumption the harness's error predictions make.
 
 use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
-use crate::simd::{Mask, WIDTH};
+use crate::simd::{Isa, Kernel, Lanes, Mask, WIDTH};
 use super::stream::SampleStream;
 
 pub struct Independent;
@@ -31,31 +31,61 @@ impl SampleGenerator for Independent {
         }
     }
 
-    /// The packet's streams with the per-(seed, strategy) part of their keys computed once, not
-    /// once per lane (two of the four SplitMix rounds of a key).
+    /// The packet's sixteen streams side by side, as 64-bit lanes compiled for the CPU's ISA
+    /// (inactive lanes are computed too and their values are unspecified), with the
+    /// per-(seed, strategy) part of their keys computed once per packet when the lanes share
+    /// it. The same numbers as [`Self::fill`] (`lanes_fill_as_single_samples`,
+    /// `every_isa_fills_as_one_stream`).
     fn fill_lanes(
         &self,
         _setup: &Setup,
         keys: &[SampleKey; WIDTH],
-        lanes: Mask,
+        _lanes: Mask,
         dims: usize,
         out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
     ) {
         let first = (keys[0].seed, keys[0].strategy);
-        let base = SampleStream::base(first.0, first.1);
-        let mut streams: [SampleStream; WIDTH] = std::array::from_fn(|i| {
-            let k = &keys[i];
+        let shared = SampleStream::base(first.0, first.1);
+        let base = keys.map(|k| {
             if (k.seed, k.strategy) == first {
-                SampleStream::keyed(base, k.pixel, k.index)
+                shared
             } else {
-                SampleStream::new(k.seed, k.strategy, k.pixel, k.index)
+                SampleStream::base(k.seed, k.strategy)
             }
         });
-        for (lane, (s, o)) in streams.iter_mut().zip(out.iter_mut()).enumerate() {
-            if lanes & (1 << lane) != 0 {
-                for x in &mut o[..dims] {
-                    *x = s.next_1d();
-                }
+        crate::simd::run(
+            Isa::best(),
+            FillLanes {
+                base,
+                pixel: keys.map(|k| k.pixel),
+                pass: keys.map(|k| k.index),
+                dims,
+                out,
+            },
+        );
+    }
+}
+
+/// [`Independent::fill_lanes`]'s loops, run in the SIMD layer's ISA context so that they
+/// vectorise (integer lanes are plain arrays: the lane layer has no 64-bit type).
+struct FillLanes<'a> {
+    base: [u64; WIDTH],
+    pixel: [u64; WIDTH],
+    pass: [u64; WIDTH],
+    dims: usize,
+    out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+}
+
+impl Kernel for FillLanes<'_> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let (mut state, increment) =
+            SampleStream::keyed_lanes(&self.base, &self.pixel, &self.pass);
+        for d in 0..self.dims.min(MAX_DIMENSIONS) {
+            let x = SampleStream::next_1d_lanes(&mut state, &increment);
+            for (o, &x) in self.out.iter_mut().zip(x.iter()) {
+                o[d] = x;
             }
         }
     }
@@ -87,4 +117,43 @@ mod tests {
     const PINNED: [u32; 6] = [
         1060333350, 1062646452, 1050276256, 1058842441, 1045468896, 1054336956,
     ];
+}
+
+#[cfg(test)]
+mod lane_tests {
+    use super::*;
+    use crate::sampling::Layout;
+
+    /// Every ISA's build of the packet fill gives the numbers of one stream at a time, for
+    /// lanes of different strategies too (integer lanes: nothing may differ).
+    #[test]
+    fn every_isa_fills_as_one_stream() {
+        let setup = Setup::point(Layout::default(), None);
+        let dims = 11;
+        let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
+            seed: 9,
+            strategy: 0x5eed + (i as u64 % 3),
+            pixel: i as u64 * 1_000_003,
+            index: u64::MAX - i as u64,
+        });
+        let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+        for (k, w) in keys.iter().zip(want.iter_mut()) {
+            INDEPENDENT.fill(&setup, *k, &mut w[..dims]);
+        }
+        for isa in Isa::available() {
+            let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+            crate::simd::run(
+                isa,
+                FillLanes {
+                    base: keys.map(|k| SampleStream::base(k.seed, k.strategy)),
+                    pixel: keys.map(|k| k.pixel),
+                    pass: keys.map(|k| k.index),
+                    dims,
+                    out: &mut got,
+                },
+            );
+            let bits = |a: [[f32; MAX_DIMENSIONS]; WIDTH]| a.map(|r| r.map(f32::to_bits));
+            assert_eq!(bits(got), bits(want), "{isa:?}");
+        }
+    }
 }

@@ -2,6 +2,7 @@
 //! depends on the seed and never on thread scheduling or tile order.
 
 use crate::math::mix64;
+use crate::simd::WIDTH;
 
 /// PCG32 (O'Neill 2014: 64-bit LCG state, XSH-RR output), seeded exactly as
 /// `rand_pcg::Pcg32::seed_from_u64` seeds it, so every stream is bit-identical to the crate's
@@ -67,6 +68,47 @@ impl SampleStream {
             .wrapping_mul(MULTIPLIER)
             .wrapping_add(increment);
         SampleStream { state, increment }
+    }
+
+    /// Sixteen streams side by side: the (state, increment) of `keyed(base[i], pixel[i],
+    /// pass[i])` for every lane i, written as plain loops over lanes. Called inside a SIMD
+    /// layer kernel they are compiled for its ISA and vectorise; integer operations only, so
+    /// every ISA gives the same bits.
+    #[inline(always)]
+    pub fn keyed_lanes(
+        base: &[u64; WIDTH],
+        pixel: &[u64; WIDTH],
+        pass: &[u64; WIDTH],
+    ) -> ([u64; WIDTH], [u64; WIDTH]) {
+        let mut key: [u64; WIDTH] = std::array::from_fn(|i| {
+            mix64(mix64(base[i] ^ pixel[i]) ^ pass[i].wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        });
+        let mut words = [[0u64; WIDTH]; 4];
+        for w in &mut words {
+            for (k, w) in key.iter_mut().zip(w.iter_mut()) {
+                *k = k.wrapping_mul(MULTIPLIER).wrapping_add(SEED_INCREMENT);
+                *w = xsh_rr(*k) as u64;
+            }
+        }
+        let increment: [u64; WIDTH] =
+            std::array::from_fn(|i| (words[2][i] | words[3][i] << 32) | 1);
+        let state = std::array::from_fn(|i| {
+            (words[0][i] | words[1][i] << 32)
+                .wrapping_add(increment[i])
+                .wrapping_mul(MULTIPLIER)
+                .wrapping_add(increment[i])
+        });
+        (state, increment)
+    }
+
+    /// [`Self::next_1d`] of each of sixteen streams given as (state, increment) lanes.
+    #[inline(always)]
+    pub fn next_1d_lanes(state: &mut [u64; WIDTH], increment: &[u64; WIDTH]) -> [f32; WIDTH] {
+        std::array::from_fn(|i| {
+            let old = state[i];
+            state[i] = old.wrapping_mul(MULTIPLIER).wrapping_add(increment[i]);
+            (xsh_rr(old) >> 8) as f32 * (1.0 / 16_777_216.0)
+        })
     }
 
     #[inline(always)]

@@ -39,6 +39,15 @@ impl Isa {
         Isa::ALL.into_iter().filter(|i| i.supported()).collect()
     }
 
+    /// The best supported ISA (no allocation, no environment: for per-packet use where every
+    /// ISA gives the same bits).
+    pub fn best() -> Isa {
+        Isa::ALL
+            .into_iter()
+            .find(|i| i.supported())
+            .unwrap_or(Isa::Portable)
+    }
+
     /// The best supported ISA, unless `DIBENCH_ISA` names one.
     pub fn detect() -> Result<Isa> {
         match std::env::var("DIBENCH_ISA") {
