@@ -443,7 +443,11 @@ impl simd::Kernel for ShadingKernel<'_> {
     #[inline(always)]
     fn run<L: Lanes>(self) -> Self::Out {
         let (g, cam) = (self.0, self.1);
-        let v = g.v.map(|v| V3::<L::V>::load(&v));
+        let v = [
+            V3::<L::V>::load(&g.v[0]),
+            V3::load(&g.v[1]),
+            V3::load(&g.v[2]),
+        ];
         let (tp, terr) = Triangle::point_lanes(v, L::V::load(&g.b1), L::V::load(&g.b2));
         let p = V3::select(g.given, V3::load(&g.p), tp);
         let p_error = V3::select(g.given, V3::load(&g.p_error), terr);

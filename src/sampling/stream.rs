@@ -75,14 +75,18 @@ impl SampleStream {
     /// layer kernel they are compiled for its ISA and vectorise; integer operations only, so
     /// every ISA gives the same bits.
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // index loops are what vectorise here
     pub fn keyed_lanes(
         base: &[u64; WIDTH],
         pixel: &[u64; WIDTH],
         pass: &[u64; WIDTH],
     ) -> ([u64; WIDTH], [u64; WIDTH]) {
-        let mut key: [u64; WIDTH] = std::array::from_fn(|i| {
-            mix64(mix64(base[i] ^ pixel[i]) ^ pass[i].wrapping_mul(0x9E37_79B9_7F4A_7C15))
-        });
+        // Plain loops, not `array::from_fn`: its closure is not inlined into the ISA's entry,
+        // and would run as scalar code outside it.
+        let mut key = [0u64; WIDTH];
+        for i in 0..WIDTH {
+            key[i] = mix64(mix64(base[i] ^ pixel[i]) ^ pass[i].wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        }
         let mut words = [[0u64; WIDTH]; 4];
         for w in &mut words {
             for (k, w) in key.iter_mut().zip(w.iter_mut()) {
@@ -90,25 +94,28 @@ impl SampleStream {
                 *w = xsh_rr(*k) as u64;
             }
         }
-        let increment: [u64; WIDTH] =
-            std::array::from_fn(|i| (words[2][i] | words[3][i] << 32) | 1);
-        let state = std::array::from_fn(|i| {
-            (words[0][i] | words[1][i] << 32)
+        let (mut state, mut increment) = ([0u64; WIDTH], [0u64; WIDTH]);
+        for i in 0..WIDTH {
+            increment[i] = (words[2][i] | words[3][i] << 32) | 1;
+            state[i] = (words[0][i] | words[1][i] << 32)
                 .wrapping_add(increment[i])
                 .wrapping_mul(MULTIPLIER)
-                .wrapping_add(increment[i])
-        });
+                .wrapping_add(increment[i]);
+        }
         (state, increment)
     }
 
     /// [`Self::next_1d`] of each of sixteen streams given as (state, increment) lanes.
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)]
     pub fn next_1d_lanes(state: &mut [u64; WIDTH], increment: &[u64; WIDTH]) -> [f32; WIDTH] {
-        std::array::from_fn(|i| {
+        let mut out = [0.0f32; WIDTH];
+        for i in 0..WIDTH {
             let old = state[i];
             state[i] = old.wrapping_mul(MULTIPLIER).wrapping_add(increment[i]);
-            (xsh_rr(old) >> 8) as f32 * (1.0 / 16_777_216.0)
-        })
+            out[i] = (xsh_rr(old) >> 8) as f32 * (1.0 / 16_777_216.0);
+        }
+        out
     }
 
     #[inline(always)]
