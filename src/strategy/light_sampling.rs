@@ -205,13 +205,29 @@ impl<'s> BoundLights<'s> {
         u: &mut [Dims; LANES],
         out: &mut [Option<LightProbe>; LANES],
     ) {
+        for (o, p) in out.iter_mut().zip(points) {
+            if p.is_some() {
+                *o = None;
+            }
+        }
+        self.probe_packet_each(points, u, |lane, probe| out[lane] = Some(probe));
+    }
+
+    /// [`Self::probe_packet`], handing each lane's probe to `emit` (lane, probe) instead of
+    /// storing it: a caller that keeps only the shadow probe lets the rest go unbuilt.
+    #[inline(always)]
+    pub fn probe_packet_each(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        u: &mut [Dims; LANES],
+        mut emit: impl FnMut(usize, LightProbe),
+    ) {
         let mut q = LaneQuery::default();
         let mut x = ShadowLanes::default();
         let mut light = [usize::MAX; LANES];
         let mut chosen = 0u32;
         for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
             let Some(sp) = sp else { continue };
-            out[lane] = None;
             let u_select = u.get_1d();
             let ul = u.get_3d();
             let ctx = sp.light_ctx();
@@ -270,7 +286,10 @@ impl<'s> BoundLights<'s> {
             sample.pdf = r.pdf[lane];
             let value = sp.bsdf.eval_local(local) * sample.radiance * r.factor[lane];
             let ray = Ray::new(sp.origin, r.dir.get(lane), r.tmax[lane]);
-            out[lane] = Some((ShadowProbe { ray, value }, sample, local, light[lane]));
+            emit(
+                lane,
+                (ShadowProbe { ray, value }, sample, local, light[lane]),
+            );
         }
     }
 
@@ -393,15 +412,12 @@ impl Estimator for LightEstimator<'_> {
         u: &mut [Dims; LANES],
         out: &mut [Probes; LANES],
     ) {
-        let mut probes = [None; LANES];
-        self.0.probe_packet(points, u, &mut probes);
-        for ((o, p), sp) in out.iter_mut().zip(probes).zip(points) {
-            if sp.is_some() {
-                *o = match p {
-                    Some((p, ..)) => Probes::shadow(p),
-                    None => Probes::default(),
-                };
+        for (o, p) in out.iter_mut().zip(points) {
+            if p.is_some() {
+                *o = Probes::default();
             }
         }
+        self.0
+            .probe_packet_each(points, u, |lane, (p, ..)| out[lane] = Probes::shadow(p));
     }
 }
