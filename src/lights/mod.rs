@@ -352,6 +352,23 @@ impl LaneSamples {
     }
 }
 
+/// [`Light::sample`] lane by lane: what [`Light::sample_lanes`] does for a light without a
+/// kernel over lanes, and for the methods a light's kernel does not cover.
+pub fn sample_lane_by_lane<T: Light + ?Sized>(
+    light: &T,
+    q: &LaneQuery,
+    active: u32,
+    m: &LightMethods,
+    out: &mut LaneSamples,
+) {
+    for lane in 0..WIDTH {
+        if active >> lane & 1 != 0 {
+            let u = [q.u[0][lane], q.u[1][lane], q.u[2][lane]];
+            out.set(lane, light.sample(&q.ctx(lane), u, m));
+        }
+    }
+}
+
 /// pbrt-v4's ShadowEpsilon: a shadow segment stops this fraction short of the (offset) light
 /// point.
 pub const SHADOW_EPSILON: f32 = 1e-4;
@@ -458,20 +475,18 @@ pub trait Light: Send + Sync + std::fmt::Debug {
     fn sample(&self, ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample>;
 
     /// [`Self::sample`] for the lanes of `active` (bit i = lane i) at once, on the lane layer's
-    /// `isa`: lane i of `out` becomes what [`Self::sample`] returns for lane i, bit for bit
-    /// (other lanes are left as they were), and the answer is true. A light without a kernel
-    /// over lanes for methods `m` touches nothing and answers false (the default): its caller
-    /// then samples those lanes one at a time, which is faster than going through lanes
-    /// without a kernel (#19 part B).
+    /// `isa`: lane i of `out` is what [`Self::sample`] returns for lane i, bit for bit (other
+    /// lanes are left as they were). The default samples lane by lane; a light with a
+    /// kernel over lanes overrides it for the methods the kernel covers (#19 part B).
     fn sample_lanes(
         &self,
         _isa: Isa,
-        _q: &LaneQuery,
-        _active: u32,
-        _m: &LightMethods,
-        _out: &mut LaneSamples,
-    ) -> bool {
-        false
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        out: &mut LaneSamples,
+    ) {
+        sample_lane_by_lane(self, q, active, m, out)
     }
 
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to

@@ -5,7 +5,7 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
-    QuadMethod, direction_to,
+    QuadMethod, direction_to, sample_lane_by_lane,
 };
 use crate::math::gamma;
 use crate::math::luminance;
@@ -200,7 +200,7 @@ impl Light for QuadLight {
         active: u32,
         m: &LightMethods,
         out: &mut LaneSamples,
-    ) -> bool {
+    ) {
         struct Area<'a>(&'a QuadLight, &'a LaneQuery, u32, &'a mut LaneSamples);
         impl Kernel for Area<'_> {
             type Out = ();
@@ -209,12 +209,10 @@ impl Light for QuadLight {
                 self.0.sample_area_lanes::<L::V>(self.1, self.2, self.3)
             }
         }
-        // The spherical rectangle's f64 set-up stays scalar (#19 item 7 allows it).
         match m.quad {
             QuadMethod::Area => simd::run(isa, Area(self, q, active, out)),
-            QuadMethod::SolidAngle => return false,
+            QuadMethod::SolidAngle => sample_lane_by_lane(self, q, active, m, out),
         }
-        true
     }
 
     fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {

@@ -185,28 +185,6 @@ impl<'s> BoundLights<'s> {
         let (light, ls) =
             self.lights
                 .sample(self.selector, &sp.light_ctx(), u_select, ul, &self.methods)?;
-        self.finish(sp, light, ls)
-    }
-
-    /// [`Self::probe`] once light `light` was chosen with probability `pmf`.
-    fn probe_chosen(
-        &self,
-        sp: &ShadingPoint,
-        light: usize,
-        pmf: f32,
-        ul: [f32; 3],
-    ) -> Option<LightProbe> {
-        let mut ls = self
-            .lights
-            .get(light)
-            .sample(&sp.light_ctx(), ul, &self.methods)?;
-        ls.pdf *= pmf;
-        self.finish(sp, light, ls)
-    }
-
-    /// The probe of light sample `ls` (pdf with the selection's).
-    #[inline(always)]
-    fn finish(&self, sp: &ShadingPoint, light: usize, ls: LightSample) -> Option<LightProbe> {
         let cos = sp.n.dot(ls.wi);
         if cos <= 0.0 {
             return None;
@@ -218,10 +196,9 @@ impl<'s> BoundLights<'s> {
     }
 
     /// [`Self::probe`] for a packet of shading points, bit for bit: the lights are chosen lane
-    /// by lane; each chosen light with a kernel over lanes ([`Light::sample_lanes`]) samples
-    /// its lanes at once, and their shadow segments, cosines and pdfs are computed over lanes
-    /// (only f is evaluated lane by lane); lanes whose light has no kernel are finished one at
-    /// a time. Lanes without a point are left as they are.
+    /// by lane, each chosen light samples its lanes at once ([`Light::sample_lanes`]), and the
+    /// shadow segments, cosines and pdfs are computed over lanes; only f is evaluated lane by
+    /// lane. Lanes without a point are left as they are.
     pub fn probe_packet(
         &self,
         points: &[Option<ShadingPoint>; LANES],
@@ -272,11 +249,9 @@ impl<'s> BoundLights<'s> {
             x.s.set(lane, sp.bsdf.frame.s);
             x.t.set(lane, sp.bsdf.frame.t);
         }
-        // Each chosen light samples its lanes at once, or, without a kernel over lanes, the
-        // lanes that chose it are finished one at a time.
+        // Each chosen light samples its lanes at once.
         let mut ls = LaneSamples::default();
         let mut rest = chosen;
-        let mut lanes = 0;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
             let mut mask = 0;
@@ -286,25 +261,9 @@ impl<'s> BoundLights<'s> {
                 }
             }
             rest &= !mask;
-            if self
-                .lights
+            self.lights
                 .get(i)
-                .sample_lanes(self.isa, &q, mask, &self.methods, &mut ls)
-            {
-                lanes |= mask;
-                continue;
-            }
-            for (lane, sp) in points.iter().enumerate() {
-                if let (true, Some(sp)) = (mask >> lane & 1 != 0, sp) {
-                    let ul = [q.u[0][lane], q.u[1][lane], q.u[2][lane]];
-                    if let Some(p) = self.probe_chosen(sp, i, x.pmf[lane], ul) {
-                        emit(lane, p);
-                    }
-                }
-            }
-        }
-        if lanes == 0 {
-            return;
+                .sample_lanes(self.isa, &q, mask, &self.methods, &mut ls);
         }
         struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes);
         impl simd::Kernel for Kernel<'_> {
