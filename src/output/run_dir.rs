@@ -181,7 +181,7 @@ impl Shared {
 
     fn abandon(&self, status: Status, error: Option<String>) {
         if !self.keep.load(Ordering::SeqCst) {
-            let _ = std::fs::remove_dir_all(&self.path);
+            remove_run_dir(&self.path);
             return;
         }
         let last = self
@@ -197,6 +197,33 @@ impl Shared {
     }
 }
 
+/// Removes a run directory so that no kill leaves it half-removed under its own name (its
+/// run.json gone, its lock free: a directory no later run could account for). It is first
+/// renamed, atomically, to a temporary name of this process; if this process dies while
+/// removing it, a later run removes what is left (`is_dead_temp`, in [`mark_dead_runs`]).
+fn remove_run_dir(dir: &Path) {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let (Some(parent), Some(name)) = (dir.parent(), dir.file_name()) else {
+        let _ = std::fs::remove_dir_all(dir);
+        return;
+    };
+    let tmp = parent.join(format!(
+        ".{}.{}.rm{}{}",
+        name.to_string_lossy(),
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::SeqCst),
+        super::TEMP_SUFFIX
+    ));
+    match std::fs::rename(dir, &tmp) {
+        Ok(()) => {
+            let _ = std::fs::remove_dir_all(&tmp);
+        }
+        Err(_) => {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
+}
+
 /// Finds the runs in `scene_dir` whose process ended while running (`run.json` says `running`
 /// but nobody holds the lock): removes their temporary files, and marks them `unfinished`, or
 /// removes them when they hold no results.
@@ -206,9 +233,13 @@ fn mark_dead_runs(scene_dir: &Path) {
     };
     for e in entries.flatten() {
         let dir = e.path();
-        // A run directory being built by a process that died.
-        if super::is_dead_temp(&e.file_name().to_string_lossy()) {
-            let _ = std::fs::remove_dir_all(&dir);
+        // A run directory being built, or being removed: by a process that died, it goes; by a
+        // live one, it is that process's.
+        let name = e.file_name().to_string_lossy().into_owned();
+        if super::is_temp_name(&name) {
+            if super::is_dead_temp(&name) {
+                let _ = std::fs::remove_dir_all(&dir);
+            }
             continue;
         }
         let Ok(lock) = super::open_lock(&dir.join(LOCK), false) else {
@@ -228,7 +259,7 @@ fn mark_dead_runs(scene_dir: &Path) {
         if value.get("status").and_then(Value::as_str) == Some(Status::Running.name()) {
             if !dir.join("results.csv").exists() {
                 drop(lock);
-                let _ = std::fs::remove_dir_all(&dir);
+                remove_run_dir(&dir);
                 continue;
             }
             value["status"] = Status::Unfinished.name().into();
@@ -240,6 +271,37 @@ fn mark_dead_runs(scene_dir: &Path) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A run directory removed by `remove_run_dir` leaves nothing, and one a process was
+    /// killed while removing (renamed to its temporary name, partly emptied) is removed by the
+    /// next run's sweep. Control: a live process's temporary directory stays.
+    #[test]
+    fn a_half_removed_run_directory_is_swept() {
+        let dir = tempfile::tempdir().unwrap();
+        let run = dir.path().join("r-seed1");
+        std::fs::create_dir(&run).unwrap();
+        std::fs::write(run.join(RUN_JSON), "{}").unwrap();
+        std::fs::write(run.join(LOCK), "").unwrap();
+        remove_run_dir(&run);
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        // pid_max is at most 2^22: this pid is dead.
+        let dead = dir.path().join(format!(
+            ".r-seed1.2147483000.rm0{}",
+            super::super::TEMP_SUFFIX
+        ));
+        let live = dir.path().join(format!(
+            ".q-seed1.{}.rm0{}",
+            std::process::id(),
+            super::super::TEMP_SUFFIX
+        ));
+        for d in [&dead, &live] {
+            std::fs::create_dir(d).unwrap();
+            std::fs::write(d.join(LOCK), "").unwrap();
+        }
+        mark_dead_runs(dir.path());
+        assert!(!dead.exists());
+        assert!(live.exists());
+    }
 
     #[test]
     fn the_same_name_twice_gives_two_directories() {
