@@ -133,7 +133,7 @@ pub fn mix64(mut z: u64) -> u64 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -187,26 +187,33 @@ mod tests {
         }
     }
 
+    /// Zeros, subnormals, the extremes, infinities, NaNs of both signs and a few neighbours of
+    /// them: the values every `next_f32` test (scalar and lanes) starts from.
+    pub(crate) const SPECIAL_F32: [f32; 16] = [
+        0.0,
+        -0.0,
+        f32::from_bits(1),
+        -f32::from_bits(1),
+        f32::MIN_POSITIVE,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        -f32::NAN,
+        1.0,
+        -1.0,
+        f32::from_bits(0x7f7f_ffff),
+        f32::from_bits(0x8000_0002),
+        3.5,
+    ];
+
     /// `next_f32` is std's `next_up`/`next_down` on zeros, subnormals, the extremes,
     /// infinities, NaN and a spread of bit patterns.
     #[test]
     fn next_f32_is_std() {
-        let special = [
-            0.0f32,
-            -0.0,
-            f32::from_bits(1),
-            -f32::from_bits(1),
-            f32::MIN_POSITIVE,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            1.0,
-            -1.0,
-        ];
         let spread = (0..100_000u64).map(|i| f32::from_bits((mix64(i) >> 32) as u32));
-        for x in special.into_iter().chain(spread) {
+        for x in SPECIAL_F32.into_iter().chain(spread) {
             for (up, want) in [(true, x.next_up()), (false, x.next_down())] {
                 let got = next_f32(x, up);
                 assert!(

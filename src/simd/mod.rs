@@ -212,24 +212,7 @@ mod tests {
     /// infinities, NaN and a spread of bit patterns, each lane up or down by its mask bit.
     #[test]
     fn lane_next_f32_is_the_scalar_one() {
-        let mut xs = vec![
-            0.0f32,
-            -0.0,
-            f32::from_bits(1),
-            -f32::from_bits(1),
-            f32::MIN_POSITIVE,
-            f32::MAX,
-            f32::MIN,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            -f32::NAN,
-            1.0,
-            -1.0,
-            f32::from_bits(0x7f7f_ffff),
-            f32::from_bits(0x8000_0002),
-            3.5,
-        ];
+        let mut xs = crate::math::tests::SPECIAL_F32.to_vec();
         xs.extend((0..4096u64).map(|i| f32::from_bits((crate::math::mix64(i) >> 32) as u32)));
         for up in [0xffff, 0, 0b1010_0110_0101_1001, 0b0101_1001_1010_0110] {
             let want: Vec<u32> = xs
