@@ -85,11 +85,15 @@ pub fn exit_now() -> ! {
     while CRITICAL.load(SeqCst) > 0 && start.elapsed() < WRITE_GRACE {
         std::thread::sleep(Duration::from_millis(5));
     }
-    for (_, path) in lock(&TEMPS).drain(..) {
-        let _ = std::fs::remove_file(path);
-    }
     for (_, hook) in lock(&HOOKS).iter() {
         hook();
+    }
+    // Held until the process ends: a write that outlived the grace cannot create a temporary
+    // file after these are removed (see `create_temp`). Writers write through the file's open
+    // handle, never by its name, so one still writing cannot bring a removed file back.
+    let mut temps = lock(&TEMPS);
+    for (_, path) in temps.drain(..) {
+        let _ = std::fs::remove_file(path);
     }
     note("interrupted: exiting now");
     std::process::exit(130)
@@ -165,11 +169,25 @@ impl Drop for ExitHook {
     }
 }
 
-/// Registers a temporary file, removed by an exit on Ctrl-C that cannot wait for its write.
-pub fn register_temp(path: PathBuf) -> TempRegistration {
+/// Creates a temporary file with `create` and registers it, so that an exit on Ctrl-C that
+/// cannot wait for its write removes it. Creation and registration are one step under the
+/// registry's lock, which the exit holds from removing the registered files to its end: every
+/// temporary file is either registered before they are removed, or never created.
+pub fn create_temp<E>(
+    create: impl FnOnce() -> Result<tempfile::NamedTempFile, E>,
+) -> Result<(tempfile::NamedTempFile, TempRegistration), E> {
+    let mut temps = lock(&TEMPS);
+    if EXITING.load(SeqCst) && !EXIT_THREAD.with(|t| t.get()) {
+        drop(temps);
+        // The process is about to exit; the file could only be left behind.
+        loop {
+            std::thread::park();
+        }
+    }
+    let file = create()?;
     let id = NEXT_ID.fetch_add(1, SeqCst);
-    lock(&TEMPS).push((id, path));
-    TempRegistration(id)
+    temps.push((id, file.path().to_path_buf()));
+    Ok((file, TempRegistration(id)))
 }
 
 pub struct TempRegistration(u64);

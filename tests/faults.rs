@@ -326,6 +326,32 @@ fn wait_for_under(root: &Path, name: &str) -> std::path::PathBuf {
     }
 }
 
+/// Waits (at most a minute) until the store `dir` holds a manifest written since `since`
+/// that records at least 64 spp.
+fn wait_for_checkpoint(dir: &Path, since: std::time::SystemTime) {
+    let start = Instant::now();
+    loop {
+        let fresh = check_store(dir, false)
+            .unwrap_or_default()
+            .iter()
+            .any(|(name, v)| {
+                v["spp"].as_u64().is_some_and(|s| s >= 64)
+                    && std::fs::metadata(dir.join(name))
+                        .and_then(|m| m.modified())
+                        .is_ok_and(|t| t >= since)
+            });
+        if fresh {
+            return;
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no checkpoint in {}",
+            dir.display()
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
 /// Sends `count` SIGINTs 20 ms apart and waits for the end (at most 20 s: a bound on hangs).
 fn interrupt(mut child: std::process::Child, count: usize) -> std::process::Output {
     for _ in 0..count {
@@ -335,12 +361,41 @@ fn interrupt(mut child: std::process::Child, count: usize) -> std::process::Outp
     let start = Instant::now();
     while child.try_wait().unwrap().is_none() {
         if start.elapsed() > Duration::from_secs(20) {
+            // What each thread was doing (state and kernel wait channel), then what it said.
+            let threads = thread_states(child.id());
             let _ = child.kill();
-            panic!("no end 20 s after Ctrl-C");
+            let out = child.wait_with_output().unwrap();
+            panic!(
+                "no end 20 s after Ctrl-C; threads: {threads}; stderr: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
         }
         std::thread::sleep(Duration::from_millis(5));
     }
     child.wait_with_output().unwrap()
+}
+
+/// `name:state:wchan` of each thread of process `pid` (Linux /proc), for a hang's report.
+fn thread_states(pid: u32) -> String {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return "unknown".into();
+    };
+    let mut states: Vec<String> = tasks
+        .flatten()
+        .map(|t| {
+            let read = |f: &str| std::fs::read_to_string(t.path().join(f)).unwrap_or_default();
+            let stat = read("stat");
+            // The state follows the parenthesised name, which may contain spaces.
+            let state = stat
+                .rsplit_once(") ")
+                .map_or("?", |(_, r)| &r[..1])
+                .to_string();
+            format!("{}:{state}:{}", read("comm").trim(), read("wchan").trim())
+        })
+        .collect();
+    states.sort();
+    states.dedup();
+    states.join(" ")
 }
 
 fn spawn(args: &[&str], cwd: &Path) -> std::process::Child {
@@ -469,7 +524,8 @@ fn double_ctrl_c_leaves_a_truthful_run_and_no_temporary_file() {
             .unwrap()
             .is_empty()
     );
-    assert!(temps_under(other.path()).is_empty());
+    let temps = temps_under(other.path());
+    assert!(temps.is_empty(), "{temps:?}");
 }
 
 /// Ctrl-C in the phases that used to ignore it: creating 1024 worker threads, loading a large
@@ -504,6 +560,9 @@ fn ctrl_c_is_answered_in_every_phase() {
     )
     .unwrap();
     std::fs::write(dir.path().join("tiny.toml"), TINY).unwrap();
+    // The reference case is interrupted once a checkpoint of its own is stored (a fixed delay
+    // reaches none on a loaded machine); the others after a delay that lands in each phase.
+    const CHECKPOINT: u64 = u64::MAX;
     for (args, after_ms) in [
         (
             &["compare", "tiny.toml", "--threads", "1024", "--out", "out"][..],
@@ -532,11 +591,16 @@ fn ctrl_c_is_answered_in_every_phase() {
                 "--out",
                 "out",
             ][..],
-            300,
+            CHECKPOINT,
         ),
     ] {
+        let spawned = std::time::SystemTime::now();
         let child = spawn(args, dir.path());
-        std::thread::sleep(Duration::from_millis(after_ms));
+        if after_ms == CHECKPOINT {
+            wait_for_checkpoint(&dir.path().join("out/tiny/reference"), spawned);
+        } else {
+            std::thread::sleep(Duration::from_millis(after_ms));
+        }
         let out = interrupt(child, 1);
         use std::os::unix::process::ExitStatusExt;
         let (code, sig) = (out.status.code(), out.status.signal());

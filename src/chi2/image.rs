@@ -34,8 +34,7 @@ pub fn write_png(path: &Path, h: &Histogram) -> Result<()> {
             }
         }
     }
-    write_atomic(path, |tmp| {
-        let file = std::fs::File::create(tmp).map_err(|e| Error::io(path, e))?;
+    write_atomic(path, |file| {
         let mut enc = png::Encoder::new(std::io::BufWriter::new(file), width as u32, ph as u32);
         enc.set_color(png::ColorType::Rgb);
         enc.set_depth(png::BitDepth::Eight);

@@ -297,12 +297,12 @@ pub fn save(
             NewFile {
                 role: "image",
                 ext: "exr",
-                write: Box::new(|p| encode_exr(p, image, p, Some(&provenance))),
+                write: Box::new(|f, p| encode_exr(f, image, p, Some(&provenance))),
             },
             NewFile {
                 role: "variance",
                 ext: "variance.exr",
-                write: Box::new(|p| encode_exr(p, variance, p, Some(&of_variance))),
+                write: Box::new(|f, p| encode_exr(f, variance, p, Some(&of_variance))),
             },
         ],
     )

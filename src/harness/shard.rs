@@ -14,6 +14,7 @@ use crate::prepare::PreparedScene;
 use crate::render::Renderer;
 use crate::strategy::Integrand;
 use serde::{Deserialize, Serialize};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -141,7 +142,7 @@ pub fn save_shard(unit: &Locked, film: &Film, meta: &ShardMeta) -> Result<PathBu
         vec![NewFile {
             role: "film",
             ext: "bin",
-            write: Box::new(|p| std::fs::write(p, &bytes).map_err(|e| Error::io(p, e))),
+            write: Box::new(|f, p| f.write_all(&bytes).map_err(|e| Error::io(p, e))),
         }],
     )
 }

@@ -91,19 +91,19 @@ impl Provenance {
 /// RGB f32 EXR, ZIP-compressed scan lines (tiled files trip up some readers, e.g. tinyexr),
 /// written atomically.
 pub fn write_exr(path: &Path, img: &RgbImage) -> Result<()> {
-    super::write_atomic(path, |tmp| encode_exr(tmp, img, path, None))
+    super::write_atomic(path, |file| encode_exr(file, img, path, None))
 }
 
 /// [`write_exr`] with the image's provenance in the header.
 pub fn write_exr_with(path: &Path, img: &RgbImage, provenance: &Provenance) -> Result<()> {
-    super::write_atomic(path, |tmp| encode_exr(tmp, img, path, Some(provenance)))
+    super::write_atomic(path, |file| encode_exr(file, img, path, Some(provenance)))
 }
 
-/// Writes `img` as an EXR to the file `to` directly (errors name `named`), with `provenance`
+/// Writes `img` as an EXR into the open file `to` (errors name `named`), with `provenance`
 /// in its header if given: for writers that already write to a temporary file, such as a
 /// store commit.
 pub fn encode_exr(
-    to: &Path,
+    to: &mut std::fs::File,
     img: &RgbImage,
     named: &Path,
     provenance: Option<&Provenance>,
@@ -134,7 +134,7 @@ pub fn encode_exr(
         );
         exr::image::Image::from_layer(layer)
             .write()
-            .to_file(to)
+            .to_buffered(std::io::BufWriter::new(to))
             .map_err(|e| DibenchError::Output {
                 path: named.into(),
                 message: format!("cannot write EXR: {e}"),

@@ -21,6 +21,8 @@ pub use exr::{
 
 use crate::error::{Error, Result};
 use serde::Serialize;
+use std::fs::File;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Ends the name of every temporary file dibench writes.
@@ -45,10 +47,12 @@ pub(crate) fn temp_file_in(dir: &Path, name: &str) -> Result<tempfile::NamedTemp
     builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))
 }
 
-/// Writes through `write` into a temporary file beside `path`, flushes it to disk (a full disk
-/// is reported here, not discovered later) and renames it over `path`. On any error the
-/// temporary file is removed; an exit on Ctrl-C waits for the write (`interrupt::critical`).
-pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+/// Writes through `write` into a temporary file beside `path` (through its open handle: the
+/// file is never reopened by name, so an exit that removed it cannot see it recreated),
+/// flushes it to disk (a full disk is reported here, not discovered later) and renames it over
+/// `path`. On any error the temporary file is removed; an exit on Ctrl-C waits for the write
+/// (`interrupt::critical`). Errors of `write` name `path`.
+pub fn write_atomic(path: &Path, write: impl FnOnce(&mut File) -> Result<()>) -> Result<()> {
     let dir = match path.parent().filter(|d| !d.as_os_str().is_empty()) {
         Some(d) => d,
         None => Path::new("."),
@@ -59,9 +63,8 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
         .map_or_else(|| "output".into(), |n| n.to_string_lossy().into_owned());
     crate::interrupt::critical(|| {
         remove_dead_temps(dir, &name);
-        let tmp = temp_file_in(dir, &name)?;
-        let _registered = crate::interrupt::register_temp(tmp.path().to_path_buf());
-        write(tmp.path())?;
+        let (mut tmp, _registered) = crate::interrupt::create_temp(|| temp_file_in(dir, &name))?;
+        write(tmp.as_file_mut())?;
         tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
         tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
         Ok(())
@@ -69,8 +72,8 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&Path) -> Result<()>) -> Res
 }
 
 pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
-    write_atomic(path, |tmp| {
-        std::fs::write(tmp, bytes).map_err(|e| Error::io(path, e))
+    write_atomic(path, |file| {
+        file.write_all(bytes).map_err(|e| Error::io(path, e))
     })
 }
 

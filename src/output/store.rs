@@ -25,6 +25,7 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::fs::{File, TryLockError};
+use std::io::{Read, Seek};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -48,8 +49,8 @@ pub struct Unit<M> {
     files: BTreeMap<String, (PathBuf, Vec<u8>)>,
 }
 
-/// Writes a file's content to the path it is given.
-pub type WriteFile<'a> = Box<dyn FnOnce(&Path) -> Result<()> + 'a>;
+/// Writes a file's content into the open file it is given; its errors name the path given.
+pub type WriteFile<'a> = Box<dyn FnOnce(&mut std::fs::File, &Path) -> Result<()> + 'a>;
 
 /// A file to commit: `write` writes it; `ext` ends its name; `role` names it in the manifest.
 pub struct NewFile<'a> {
@@ -280,13 +281,17 @@ impl Locked<'_> {
         crate::interrupt::critical(|| {
             let mut records = BTreeMap::new();
             for f in files {
-                let tmp = super::temp_file_in(dir, &self.stem)?;
-                let _registered = crate::interrupt::register_temp(tmp.path().to_path_buf());
-                (f.write)(tmp.path())?;
-                tmp.as_file()
-                    .sync_all()
-                    .map_err(|e| Error::io(tmp.path(), e))?;
-                let bytes = std::fs::read(tmp.path()).map_err(|e| Error::io(tmp.path(), e))?;
+                let (mut tmp, _registered) =
+                    crate::interrupt::create_temp(|| super::temp_file_in(dir, &self.stem))?;
+                let path = tmp.path().to_path_buf();
+                (f.write)(tmp.as_file_mut(), &path)?;
+                let file = tmp.as_file_mut();
+                file.sync_all().map_err(|e| Error::io(&path, e))?;
+                // Read back through the handle (never reopened by name: see `write_atomic`).
+                let mut bytes = Vec::new();
+                file.seek(std::io::SeekFrom::Start(0))
+                    .and_then(|_| file.read_to_end(&mut bytes))
+                    .map_err(|e| Error::io(&path, e))?;
                 let sha256 = hex(&Sha256::digest(&bytes));
                 let name = format!("{}.{}.{}", self.stem, &sha256[..16], f.ext);
                 tmp.persist(dir.join(&name))
@@ -352,6 +357,7 @@ fn hex(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::io::Write;
 
     #[derive(Serialize, Deserialize, PartialEq, Debug)]
     struct Meta {
@@ -362,7 +368,7 @@ mod tests {
         NewFile {
             role: "data",
             ext: "txt",
-            write: Box::new(move |p| std::fs::write(p, s).map_err(|e| Error::io(p, e))),
+            write: Box::new(move |f, p| f.write_all(s.as_bytes()).map_err(|e| Error::io(p, e))),
         }
     }
 
