@@ -123,3 +123,89 @@ impl<const N: usize> Vector<N> for P<N> {
         }))
     }
 }
+
+/// One f32 is a one-lane vector: scalar code calls a kernel written over lanes with it, so the
+/// scalar path and the lanes run one piece of code (as Mitsuba 3's warps do over `Float`), with
+/// the same operations in the same order and hence the same results.
+impl Vector<1> for f32 {
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn load(a: &[f32; 1]) -> Self {
+        a[0]
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [f32; 1]) {
+        a[0] = self;
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        self / o
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        if self < o { self } else { o }
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        if self > o { self } else { o }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::abs(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        -self
+    }
+    #[inline(always)]
+    fn next_f32(self, up: u32) -> Self {
+        crate::math::next_f32(self, up & 1 != 0)
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> u32 {
+        (self < o) as u32
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> u32 {
+        (self <= o) as u32
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> u32 {
+        (self == o) as u32
+    }
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        self.is_sign_negative() as u32
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        if m & 1 != 0 { a } else { b }
+    }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        self
+    }
+}
