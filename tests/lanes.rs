@@ -16,14 +16,17 @@ use dibench::strategy::light_sampling::{BoundLights, LightProbe};
 use dibench::strategy::{Probes, ShadingPoint, by_name};
 use dibench::tracer::LANES;
 
-/// Scenes with quad, sphere, mesh, point, spot, directional and environment lights.
-const SCENES: [&str; 6] = [
+/// Scenes with quad, sphere, mesh, point, spot, directional and environment lights, and with
+/// Phong, GGX and principled materials beside Lambertian ones (packets of mixed materials).
+const SCENES: [&str; 8] = [
     "cornell",
     "bunny",
     "sphere_light",
     "mesh_light",
     "spot_directional",
     "env_venice_bunny",
+    "glossy",
+    "ggx_gold_bunny",
 ];
 
 /// A floor under a rectangle light whose edges have no zero component, so every lane
@@ -175,7 +178,15 @@ fn light_probes_over_lanes_are_the_scalar_ones() {
 fn estimators_packets_are_their_samples() {
     for (name, scene) in scenes() {
         let packets = packets(&scene, 24);
-        for strategy in ["light", "mis-power", "mis-power-area", "mis-balance"] {
+        for strategy in [
+            "light",
+            "uniform",
+            "cosine",
+            "bsdf",
+            "mis-power",
+            "mis-power-area",
+            "mis-balance",
+        ] {
             let s = by_name(strategy).unwrap();
             let Ok(est) = s.bind(scene.view(s.integrand())) else {
                 continue;

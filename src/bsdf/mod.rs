@@ -27,6 +27,7 @@ crate::plugin::registry! {
 pub use crate::sampling::microfacet::MicrofacetSampler;
 
 use crate::math::{Frame, luminance};
+use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -195,6 +196,9 @@ pub struct Bsdf {
     /// Selection probabilities by coefficient, in lobe order; the last is 1 − Σ of the others
     /// so that they sum to one exactly.
     by_coefficient: Selection,
+    /// Every lobe is cosine-sampled ([`Lobe::is_cosine_sampled`]), so the sampled direction
+    /// does not depend on the lobe chosen.
+    cosine_sampled: bool,
 }
 
 /// Probabilities proportional to `weights` (non-negative), the last one 1 − Σ of the others;
@@ -233,6 +237,7 @@ impl Bsdf {
             p
         });
         Bsdf {
+            cosine_sampled: lobes.iter().all(|l| l.is_cosine_sampled()),
             lobes,
             by_coefficient,
         }
@@ -270,7 +275,7 @@ impl Bsdf {
 
     /// BSDF sampling is cosine sampling for this material.
     pub fn is_cosine_sampled(&self) -> bool {
-        self.lobes.iter().all(|l| l.is_cosine_sampled())
+        self.cosine_sampled
     }
 
     /// Some lobe is sampled by the strategy's [`MicrofacetSampler`].
@@ -383,6 +388,73 @@ impl LocalBsdf<'_> {
     }
 }
 
+/// Cosine-weighted directions for 16 shading frames at once: what [`sample_cosine_lanes`]
+/// loads (lanes outside the caller's mask hold anything finite).
+#[derive(Clone, Copy, Default)]
+pub struct CosineQuery {
+    /// The frames' axes.
+    pub s: Soa3,
+    pub t: Soa3,
+    pub n: Soa3,
+    /// The two sample numbers of each lane.
+    pub u: [[f32; WIDTH]; 2],
+}
+
+impl CosineQuery {
+    /// Lane `lane` samples in `frame` with numbers `u`.
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, frame: &Frame, u: [f32; 2]) {
+        self.s.set(lane, frame.s);
+        self.t.set(lane, frame.t);
+        self.n.set(lane, frame.n);
+        self.u[0][lane] = u[0];
+        self.u[1][lane] = u[1];
+    }
+}
+
+/// What [`sample_cosine_lanes`] computes for each lane.
+#[derive(Clone, Copy, Default)]
+pub struct CosineLanes {
+    /// The world direction, `frame.to_world(sample_cosine_hemisphere(u))`.
+    pub wi: Soa3,
+    /// `frame.to_local(wi)`: the direction as rounded to world space, back in the frame (f and
+    /// pdf are evaluated for it, as [`LocalBsdf::sample`] does).
+    pub local: Soa3,
+    /// z of the sample before the round trip (cos θ of the warp: `cosine`'s pdf).
+    pub z: [f32; WIDTH],
+}
+
+/// Cosine-weighted hemisphere samples in 16 frames over lanes, bit for bit as the scalar
+/// `frame.to_world(sample_cosine_hemisphere(u))` and `frame.to_local` of it: BSDF sampling of
+/// every material whose lobes are all cosine-sampled (the direction does not depend on the
+/// lobe), and the `cosine` strategy for any material.
+pub fn sample_cosine_lanes(isa: Isa, q: &CosineQuery) -> CosineLanes {
+    struct Kernel<'a>(&'a CosineQuery);
+    impl simd::Kernel for Kernel<'_> {
+        type Out = CosineLanes;
+        #[inline(always)]
+        fn run<L: Lanes>(self) -> CosineLanes {
+            let q = self.0;
+            let (s, t, n) = (V3::<L::V>::load(&q.s), V3::load(&q.t), V3::load(&q.n));
+            let (x, y, z) =
+                crate::sampling::warp::cosine_hemisphere(L::V::load(&q.u[0]), L::V::load(&q.u[1]));
+            // Frame::to_world and to_local in glam's order.
+            let wi = s.scale(x) + t.scale(y) + n.scale(z);
+            let local = V3 {
+                x: wi.dot(s),
+                y: wi.dot(t),
+                z: wi.dot(n),
+            };
+            let mut out = CosineLanes::default();
+            wi.store(&mut out.wi);
+            local.store(&mut out.local);
+            z.store(&mut out.z);
+            out
+        }
+    }
+    simd::run(isa, Kernel(q))
+}
+
 /// The χ² cases of BSDF sampling: each material type's, in [`MATERIALS`] order (from the
 /// file beside its lobe).
 pub fn chi2_cases() -> Vec<crate::chi2::WarpEntry> {
@@ -417,6 +489,52 @@ mod tests {
         assert!(albedo(&phong, grazing) < 1.0);
         let blend = Bsdf::blend(Vec3::splat(0.5), Vec3::splat(0.5), 5.0);
         assert!((albedo(&blend, Vec3::Z) - 1.0).abs() < 2e-3);
+    }
+
+    /// Cosine samples over lanes are the scalar warp and frame round trip bit for bit, on every
+    /// ISA, for frames about normals of every octant.
+    #[test]
+    fn cosine_lanes_are_the_scalar_samples_on_every_isa() {
+        use crate::sampling::warp::sample_cosine_hemisphere;
+        let mut checked = 0;
+        for k in 0..64u64 {
+            let r = |i: u64| (crate::math::mix64(k * 64 + i) >> 40) as f32 / (1u64 << 24) as f32;
+            let mut q = CosineQuery::default();
+            let mut frames = Vec::new();
+            for lane in 0..WIDTH {
+                let i = lane as u64 * 4;
+                let n = Vec3::new(2.0 * r(i) - 1.0, 2.0 * r(i + 1) - 1.0, 2.0 * r(i + 2) - 1.0)
+                    .normalize();
+                let frame = Frame::from_normal(n);
+                let u = if k == 0 {
+                    [lane as f32 / 15.0, 0.5]
+                } else {
+                    [r(i + 3), r(i + 200)]
+                };
+                q.set(lane, &frame, u);
+                frames.push((frame, u));
+            }
+            for isa in Isa::available() {
+                let got = sample_cosine_lanes(isa, &q);
+                for (lane, (frame, u)) in frames.iter().enumerate() {
+                    let local = sample_cosine_hemisphere(*u);
+                    let wi = frame.to_world(local);
+                    assert_eq!(
+                        got.wi.get(lane).to_array().map(f32::to_bits),
+                        wi.to_array().map(f32::to_bits),
+                        "{isa:?}"
+                    );
+                    assert_eq!(
+                        got.local.get(lane).to_array().map(f32::to_bits),
+                        frame.to_local(wi).to_array().map(f32::to_bits),
+                        "{isa:?}"
+                    );
+                    assert_eq!(got.z[lane].to_bits(), local.z.to_bits(), "{isa:?}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(checked >= 64 * WIDTH);
     }
 
     /// Selection by coefficient luminance: probabilities sum to one and follow the weights.

@@ -4,7 +4,7 @@
 //! Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
 
 use super::{EmissionProbe, Estimator, Probes, ShadingPoint, Strategy};
-use crate::bsdf::BsdfSampling;
+use crate::bsdf::{BsdfSample, BsdfSampling, CosineQuery, sample_cosine_lanes};
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
 use crate::sampling::warp::{
@@ -12,6 +12,8 @@ use crate::sampling::warp::{
     sample_uniform_hemisphere,
 };
 use crate::sampling::{Dimension, Dims, Layout};
+use crate::simd::Isa;
+use crate::tracer::LANES;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DirectionKind {
@@ -110,20 +112,28 @@ impl Strategy for DirectionSampling {
         if let Some(why) = self.sampling.same_as_default(&scene.world.materials) {
             return Err(format!("identical to `bsdf`: {why}"));
         }
-        Ok(Box::new(*self))
+        Ok(Box::new(DirectionEstimator {
+            strategy: *self,
+            isa: Isa::detect().unwrap_or(Isa::Portable),
+        }))
     }
 }
 
-impl Estimator for DirectionSampling {
+struct DirectionEstimator {
+    strategy: DirectionSampling,
+    isa: Isa,
+}
+
+impl Estimator for DirectionEstimator {
     fn layout(&self) -> Layout {
-        match self.kind {
+        match self.strategy.kind {
             DirectionKind::Bsdf => Layout::of(&BSDF_DIMS),
             _ => Layout::of(&[Dimension::pair("direction")]),
         }
     }
 
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes {
-        let (wi, pdf) = match self.kind {
+        let (wi, pdf) = match self.strategy.kind {
             DirectionKind::UniformHemisphere => (
                 sp.bsdf
                     .frame
@@ -138,11 +148,105 @@ impl Estimator for DirectionSampling {
                 )
             }
             DirectionKind::Bsdf => {
-                let s = sp.bsdf.sample(u.get_3d(), self.sampling);
+                let s = sp.bsdf.sample(u.get_3d(), self.strategy.sampling);
                 return emission_probe_with(sp, s.wi, s.f, s.pdf);
             }
         };
         emission_probe(sp, wi, pdf)
+    }
+
+    /// [`Self::sample`] for a packet, bit for bit: cosine-hemisphere directions (every lane of
+    /// `cosine`, the lanes of cosine-sampled materials for `bsdf`) are drawn and taken to world
+    /// space over lanes; f, the pdf and the rest lane by lane.
+    fn sample_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        u: &mut [Dims; LANES],
+        out: &mut [Probes; LANES],
+    ) {
+        match self.strategy.kind {
+            DirectionKind::UniformHemisphere => {
+                for ((p, u), o) in points.iter().zip(u.iter_mut()).zip(out.iter_mut()) {
+                    if let Some(sp) = p {
+                        *o = self.sample(sp, u);
+                    }
+                }
+            }
+            DirectionKind::CosineHemisphere => {
+                let mut q = CosineQuery::default();
+                let mut mask = 0u32;
+                for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
+                    if let Some(sp) = sp {
+                        q.set(lane, &sp.bsdf.frame, u.get_2d());
+                        mask |= 1 << lane;
+                    }
+                }
+                if mask == 0 {
+                    return;
+                }
+                let r = sample_cosine_lanes(self.isa, &q);
+                for (lane, (sp, o)) in points.iter().zip(out.iter_mut()).enumerate() {
+                    let Some(sp) = sp else { continue };
+                    let (wi, pdf) = (r.wi.get(lane), cosine_hemisphere_pdf(r.z[lane]));
+                    *o = if sp.n.dot(wi) <= 0.0 || pdf <= 0.0 {
+                        Probes::default()
+                    } else {
+                        emission_probe_with(sp, wi, sp.bsdf.eval_local(r.local.get(lane)), pdf)
+                    };
+                }
+            }
+            DirectionKind::Bsdf => bsdf_sample_packet(
+                self.isa,
+                points,
+                u,
+                self.strategy.sampling,
+                |lane, sp, s| {
+                    out[lane] = emission_probe_with(sp, s.wi, s.f, s.pdf);
+                },
+            ),
+        }
+    }
+}
+
+/// `sp.bsdf.sample(u.get_3d(), sampling)` for each lane of a packet, bit for bit, handed to
+/// `emit(lane, point, sample)`: lanes whose material is cosine-sampled draw their directions
+/// over lanes ([`sample_cosine_lanes`]: the lobe drawn by u[2] does not change the direction),
+/// the others one by one. f and the mixture pdf are evaluated lane by lane.
+#[inline(always)]
+pub fn bsdf_sample_packet<'p, 's>(
+    isa: Isa,
+    points: &'p [Option<ShadingPoint<'s>>; LANES],
+    u: &mut [Dims; LANES],
+    sampling: BsdfSampling,
+    mut emit: impl FnMut(usize, &'p ShadingPoint<'s>, BsdfSample),
+) {
+    let mut q = CosineQuery::default();
+    let mut mask = 0u32;
+    for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
+        let Some(sp) = sp else { continue };
+        let u = u.get_3d();
+        if sp.bsdf.bsdf.is_cosine_sampled() {
+            q.set(lane, &sp.bsdf.frame, [u[0], u[1]]);
+            mask |= 1 << lane;
+        } else {
+            emit(lane, sp, sp.bsdf.sample(u, sampling));
+        }
+    }
+    if mask == 0 {
+        return;
+    }
+    let r = sample_cosine_lanes(isa, &q);
+    for (lane, sp) in points.iter().enumerate() {
+        let Some(sp) = sp.as_ref().filter(|_| mask >> lane & 1 != 0) else {
+            continue;
+        };
+        let local = r.local.get(lane);
+        let sample = BsdfSample {
+            wi: r.wi.get(lane),
+            f: sp.bsdf.eval_local(local),
+            pdf: sp.bsdf.pdf_local(local, sampling),
+        };
+        emit(lane, sp, sample);
     }
 }
 

@@ -5,9 +5,12 @@
 //! includes the light-selection pmf (redner #56). The BSDF sample, and the BSDF pdf of light
 //! samples, follow the strategy's [`BsdfSampling`] part (lobe selection, GGX sampler).
 
-use super::direction::{BSDF_DIMS, emission_probe_with};
+use super::direction::{BSDF_DIMS, bsdf_sample_packet, emission_probe_with};
 use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
-use super::{EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, Strategy, env_method_name};
+use super::{
+    EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, ShadowProbe, Strategy,
+    env_method_name,
+};
 use crate::bsdf::BsdfSampling;
 use crate::env::EnvMethod;
 use crate::lights::selector::{SelectorType, default_selector};
@@ -229,18 +232,22 @@ struct MisEstimator<'s> {
 }
 
 impl MisEstimator<'_> {
-    /// The sample after its light probe: the probe's MIS weight, then the BSDF sample.
-    fn finish(&self, sp: &ShadingPoint, light: Option<LightProbe>, u: &mut Dims) -> Probes {
-        let h = self.strategy.heuristic;
-        let sampling = self.strategy.sampling;
-        let shadow = light.map(|(mut probe, ls, local, light)| {
+    /// The light probe with its MIS weight.
+    fn weighted(&self, sp: &ShadingPoint, light: Option<LightProbe>) -> Option<ShadowProbe> {
+        light.map(|(mut probe, ls, local, light)| {
             // A delta light is reachable by light sampling only: its weight is 1.
             if !self.lights.lights.get(light).is_delta() {
-                probe.value *= h.weight(ls.pdf, sp.bsdf.pdf_local(local, sampling));
+                let p_bsdf = sp.bsdf.pdf_local(local, self.strategy.sampling);
+                probe.value *= self.strategy.heuristic.weight(ls.pdf, p_bsdf);
             }
             probe
-        });
-        let bs = sp.bsdf.sample(u.get_3d(), sampling);
+        })
+    }
+
+    /// The sample after its light probe: the probe's MIS weight, then the BSDF sample.
+    fn finish(&self, sp: &ShadingPoint, light: Option<LightProbe>, u: &mut Dims) -> Probes {
+        let shadow = self.weighted(sp, light);
+        let bs = sp.bsdf.sample(u.get_3d(), self.strategy.sampling);
         let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
         Probes { shadow, emission }
     }
@@ -264,11 +271,20 @@ impl Estimator for MisEstimator<'_> {
     ) {
         let mut light = [None; LANES];
         self.lights.probe_packet(points, u, &mut light);
-        for (((o, sp), u), light) in out.iter_mut().zip(points).zip(u).zip(light) {
+        for ((o, sp), light) in out.iter_mut().zip(points).zip(light) {
             if let Some(sp) = sp {
-                *o = self.finish(sp, light, u);
+                o.shadow = self.weighted(sp, light);
             }
         }
+        bsdf_sample_packet(
+            self.lights.isa,
+            points,
+            u,
+            self.strategy.sampling,
+            |lane, sp, bs| {
+                out[lane].emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission
+            },
+        );
     }
 
     fn emission_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe, hit: &SurfaceHit) -> f32 {
