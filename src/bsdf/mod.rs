@@ -314,6 +314,11 @@ impl Bsdf {
 
     /// Mixture pdf of [`Self::sample_local`] under `sampling`, in the local frame.
     pub fn pdf(&self, wo: Vec3, wi: Vec3, sampling: BsdfSampling) -> f32 {
+        // One lobe has probability 1 under either policy: the sum below, without the
+        // selection (the same bits: 0 + 1·p).
+        if let [l] = &self.lobes[..] {
+            return 0.0 + l.pdf(wo, wi, sampling.microfacet);
+        }
         let mut pdf = 0.0;
         for (l, &p) in self.lobes.iter().zip(&self.selection(sampling.lobes, wo)) {
             if p > 0.0 {
@@ -325,6 +330,9 @@ impl Bsdf {
 
     /// u[2] chooses the lobe, u[0..2] the direction within it; local frame.
     pub fn sample_local(&self, wo: Vec3, u: [f32; 3], sampling: BsdfSampling) -> Vec3 {
+        if let [l] = &self.lobes[..] {
+            return l.sample(wo, [u[0], u[1]], sampling.microfacet);
+        }
         let probs = self.selection(sampling.lobes, wo);
         let mut cdf = 0.0;
         let mut chosen = self.lobes.len() - 1;

@@ -667,5 +667,7 @@ impl LightSet {
 /// pitfall 18).
 pub fn selection_number(hi: f32, lo: f32) -> f64 {
     const GRID: f64 = 16_777_216.0;
-    (hi as f64 * GRID).floor() / GRID + lo as f64 / GRID
+    // floor by truncation (sample numbers are non-negative, below 2^24 on the grid): one
+    // conversion instead of a call to libm's floor without SSE4.1.
+    (hi as f64 * GRID) as i64 as f64 / GRID + lo as f64 / GRID
 }

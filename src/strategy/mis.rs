@@ -269,13 +269,17 @@ impl Estimator for MisEstimator<'_> {
         u: &mut [Dims; LANES],
         out: &mut [Probes; LANES],
     ) {
-        let mut light = [None; LANES];
-        self.lights.probe_packet(points, u, &mut light);
-        for ((o, sp), light) in out.iter_mut().zip(points).zip(light) {
-            if let Some(sp) = sp {
-                o.shadow = self.weighted(sp, light);
+        for (o, sp) in out.iter_mut().zip(points) {
+            if sp.is_some() {
+                o.shadow = None;
             }
         }
+        // Each probe weighted as it is made (no packet of full light probes stored and copied).
+        self.lights.probe_packet_each(points, u, |lane, probe| {
+            if let Some(sp) = &points[lane] {
+                out[lane].shadow = self.weighted(sp, Some(probe));
+            }
+        });
         bsdf_sample_packet(
             self.lights.isa,
             points,
