@@ -9,13 +9,15 @@
 
 use super::bounds::{Bounds, LightBounds};
 use super::{
-    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, MeshMethod, direction_to,
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
+    LightMethods, LightSample, LightShape, MeshMethod, direction_to,
 };
 use crate::geometry::triangle::Triangle;
 use crate::math::gamma;
 use crate::math::luminance;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalTriangle, triangle_solid_angle};
-use crate::sampling::warp::sample_uniform_triangle;
+use crate::sampling::warp::{sample_uniform_triangle, uniform_triangle};
+use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -139,7 +141,77 @@ impl Triangle {
     }
 }
 
+/// Area sampling of mesh triangles with each lane's own triangle (its record: v0, v1, v2, the
+/// normal, the area, the radiance), over lanes.
+static AREA_LANES: LaneKernel = LaneKernel {
+    name: "mesh triangles by area",
+    sample: sample_area_lanes,
+};
+
+fn sample_area_lanes(
+    isa: Isa,
+    records: &LaneRecords,
+    q: &LaneQuery,
+    active: u32,
+    _m: &LightMethods,
+    out: &mut LaneSamples,
+) {
+    struct Kernel<'a>(&'a LaneRecords, &'a LaneQuery, u32, &'a mut LaneSamples);
+    impl simd::Kernel for Kernel<'_> {
+        type Out = ();
+        #[inline(always)]
+        fn run<L: Lanes>(self) {
+            area_lanes::<L::V>(self.0, self.1, self.2, self.3)
+        }
+    }
+    simd::run(isa, Kernel(records, q, active, out))
+}
+
+/// [`TriangleLight::sample_area`] for each lane's triangle, bit for bit.
+#[inline(always)]
+fn area_lanes<V: Vector<WIDTH>>(r: &LaneRecords, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
+    let v3 = |k: usize| V3 {
+        x: V::load(&r[k]),
+        y: V::load(&r[k + 1]),
+        z: V::load(&r[k + 2]),
+    };
+    let (b1, b2) = uniform_triangle(V::load(&q.u[0]), V::load(&q.u[1]));
+    let (point, error) = Triangle::point_lanes([v3(0), v3(3), v3(6)], b1, b2);
+    let normal = v3(9);
+    // direction_to
+    let d = point - V3::load(&q.p);
+    let d2 = d.dot(d);
+    let wi = d / d2.sqrt();
+    let cos_l = normal.dot(wi).neg();
+    let zero = V::splat(0.0);
+    let valid = a & zero.lt(d2) & !cos_l.le(zero);
+    let pdf = d2.div(V::load(&r[12]).mul(cos_l));
+    let keep = |new: V3<V>, old: &mut Soa3| V3::select(a, new, V3::load(old)).store(old);
+    keep(wi, &mut out.wi);
+    keep(point, &mut out.point);
+    keep(normal, &mut out.normal);
+    keep(error, &mut out.point_error);
+    keep(v3(13), &mut out.radiance);
+    V::select(a, pdf, V::load(&out.pdf)).store(&mut out.pdf);
+    out.valid = (out.valid & !a) | valid;
+    out.distant &= !a;
+}
+
 impl Light for TriangleLight {
+    fn lane_record(&self, m: &LightMethods) -> Option<(&'static LaneKernel, [f32; LANE_RECORD])> {
+        if m.mesh != MeshMethod::Area {
+            return None;
+        }
+        let t = &self.triangle;
+        let mut r = [0.0; LANE_RECORD];
+        for (k, v) in [t.v0, t.v1, t.v2, self.normal].iter().enumerate() {
+            r[3 * k..3 * k + 3].copy_from_slice(&v.to_array());
+        }
+        r[12] = self.area;
+        r[13..16].copy_from_slice(&self.radiance.to_array());
+        Some((&AREA_LANES, r))
+    }
+
     fn shape(&self) -> LightShape {
         LightShape::Mesh
     }

@@ -352,6 +352,37 @@ impl LaneSamples {
     }
 }
 
+/// How many f32 a light's [`LaneKernel`] record holds.
+pub const LANE_RECORD: usize = 16;
+
+/// Records of 16 lanes' lights, `records[k][lane]`: field k of lane `lane`'s light.
+pub type LaneRecords = [[f32; WIDTH]; LANE_RECORD];
+
+/// A kernel that samples the lanes of a packet together although each lane has its own light
+/// of one type (mesh triangles: every lane picks its own triangle, so sampling per light,
+/// [`Light::sample_lanes`], would run one lane at a time). Each light hands over its
+/// parameters as a record ([`Light::lane_record`]); lights answering the same kernel (the same
+/// `&'static`, compared by address) are sampled by one call.
+pub struct LaneKernel {
+    pub name: &'static str,
+    /// Lane i of `out`, for each lane of `active`, is what [`Light::sample`] of the light whose
+    /// record is lane i of `records` returns, bit for bit (other lanes are left as they were).
+    pub sample: fn(Isa, &LaneRecords, &LaneQuery, u32, &LightMethods, &mut LaneSamples),
+}
+
+impl LaneKernel {
+    /// The same kernel: identity is the static's address.
+    pub fn is(&self, other: &LaneKernel) -> bool {
+        std::ptr::eq(self, other)
+    }
+}
+
+impl std::fmt::Debug for LaneKernel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
 /// [`Light::sample`] lane by lane: what [`Light::sample_lanes`] does for a light without a
 /// kernel over lanes, and for the methods a light's kernel does not cover.
 pub fn sample_lane_by_lane<T: Light + ?Sized>(
@@ -487,6 +518,13 @@ pub trait Light: Send + Sync + std::fmt::Debug {
         out: &mut LaneSamples,
     ) {
         sample_lane_by_lane(self, q, active, m, out)
+    }
+
+    /// A kernel that samples lanes of different lights of this type at once under the methods
+    /// `m`, with this light's record for it; None (the default) where it has none: the light is
+    /// then sampled through [`Self::sample_lanes`] for the lanes that chose it.
+    fn lane_record(&self, _m: &LightMethods) -> Option<(&'static LaneKernel, [f32; LANE_RECORD])> {
+        None
     }
 
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to

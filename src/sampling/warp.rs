@@ -145,15 +145,18 @@ pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
 /// Uniform barycentrics (b1, b2) over a triangle (pbrt-v4 `SampleUniformTriangle`, after
 /// Heitz 2019's low-distortion map): area pdf 1/A.
 pub fn sample_uniform_triangle(u: [f32; 2]) -> (f32, f32) {
-    let (b0, b1);
-    if u[0] < u[1] {
-        b0 = u[0] / 2.0;
-        b1 = u[1] - b0;
-    } else {
-        b1 = u[1] / 2.0;
-        b0 = u[0] - b1;
-    }
-    (b1, 1.0 - b0 - b1)
+    uniform_triangle(u[0], u[1])
+}
+
+/// [`sample_uniform_triangle`] over lanes (and for one lane as `f32`).
+#[inline(always)]
+pub fn uniform_triangle<V: Vector<N>, const N: usize>(u0: V, u1: V) -> (V, V) {
+    let two = V::splat(2.0);
+    let first = u0.lt(u1);
+    let (h0, h1) = (u0.div(two), u1.div(two));
+    let b0 = V::select(first, h0, u0.sub(h1));
+    let b1 = V::select(first, u1.sub(h0), h1);
+    (b1, V::splat(1.0).sub(b0).sub(b1))
 }
 
 /// Uniform direction on the hemisphere about +z.
@@ -514,7 +517,7 @@ mod tests {
     struct Warps<'a>(&'a [[f32; 2]]);
 
     impl Kernel for Warps<'_> {
-        type Out = Vec<[u32; 5]>;
+        type Out = Vec<[u32; 7]>;
         fn run<L: Lanes>(self) -> Self::Out {
             let mut out = Vec::new();
             for c in self.0.chunks_exact(WIDTH) {
@@ -522,8 +525,9 @@ mod tests {
                 let u1 = L::V::load(&std::array::from_fn(|i| c[i][1]));
                 let (x, y, z) = cosine_hemisphere(u0, u1);
                 let (cc, ss) = cos_sin_turns(u1);
-                let mut o = [[0.0; WIDTH]; 5];
-                for (o, v) in o.iter_mut().zip([x, y, z, cc, ss]) {
+                let (b1, b2) = uniform_triangle(u0, u1);
+                let mut o = [[0.0; WIDTH]; 7];
+                for (o, v) in o.iter_mut().zip([x, y, z, cc, ss, b1, b2]) {
                     v.store(o);
                 }
                 out.extend((0..WIDTH).map(|i| o.map(|o| o[i].to_bits())));
@@ -532,8 +536,8 @@ mod tests {
         }
     }
 
-    /// The cosine-hemisphere warp and the turn's cosine and sine over lanes are the scalar
-    /// functions bit for bit on every ISA: the disk's centre and diagonals, the square's edges
+    /// The cosine-hemisphere and triangle warps and the turn's cosine and sine over lanes are
+    /// the scalar functions bit for bit on every ISA: the disk's centre and diagonals, the square's edges
     /// and corners, the quadrant boundaries, and a spread of points.
     #[test]
     fn lane_warps_are_the_scalar_ones_on_every_isa() {
@@ -561,12 +565,13 @@ mod tests {
             ]
         }));
         us.truncate(us.len() / WIDTH * WIDTH);
-        let want: Vec<[u32; 5]> = us
+        let want: Vec<[u32; 7]> = us
             .iter()
             .map(|&u| {
                 let w = sample_cosine_hemisphere(u);
                 let (c, s) = cos_sin_turns::<f32, 1>(u[1]);
-                [w.x, w.y, w.z, c, s].map(f32::to_bits)
+                let (b1, b2) = sample_uniform_triangle(u);
+                [w.x, w.y, w.z, c, s, b1, b2].map(f32::to_bits)
             })
             .collect();
         for isa in Isa::available() {

@@ -7,7 +7,9 @@ use super::{Estimator, Integrand, Probes, ShadingPoint, ShadowProbe, Strategy, e
 use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
-use crate::lights::{LaneQuery, LaneSamples, SHADOW_EPSILON, selection_number};
+use crate::lights::{
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, SHADOW_EPSILON, selection_number,
+};
 use crate::lights::{LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride};
 use crate::math::offset_ray_origin_lanes;
 use crate::prepare::SceneView;
@@ -249,9 +251,40 @@ impl<'s> BoundLights<'s> {
             x.s.set(lane, sp.bsdf.frame.s);
             x.t.set(lane, sp.bsdf.frame.t);
         }
-        // Each chosen light samples its lanes at once.
+        // Lights with a kernel over lanes of different lights (mesh triangles) hand over their
+        // records; each such kernel samples all its lanes at once.
         let mut ls = LaneSamples::default();
+        let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
+        let mut records: Option<Box<LaneRecords>> = None;
+        let mut with_kernel = 0u32;
         let mut rest = chosen;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            if let Some((k, r)) = self.lights.get(light[lane]).lane_record(&self.methods) {
+                let records = records.get_or_insert_with(|| Box::new([[0.0; LANES]; LANE_RECORD]));
+                for (field, v) in records.iter_mut().zip(r) {
+                    field[lane] = v;
+                }
+                kernels[lane] = Some(k);
+                with_kernel |= 1 << lane;
+            }
+        }
+        let mut rest = with_kernel;
+        while rest != 0 {
+            let k = kernels[rest.trailing_zeros() as usize].expect("a lane with a kernel");
+            let mut mask = 0;
+            for (lane, other) in kernels.iter().enumerate() {
+                if other.is_some_and(|o| o.is(k)) {
+                    mask |= 1 << lane;
+                }
+            }
+            rest &= !mask;
+            let records = records.as_deref().expect("records for lanes with a kernel");
+            (k.sample)(self.isa, records, &q, mask, &self.methods, &mut ls);
+        }
+        // Each other chosen light samples its lanes at once.
+        let mut rest = chosen & !with_kernel;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
             let mut mask = 0;
