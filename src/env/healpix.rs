@@ -43,7 +43,7 @@ pub fn uv_to_dir(uv: [f32; 2]) -> Vec3 {
 pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
     let z = w.y;
     let za = z.abs();
-    let mut phi = w.z.atan2(w.x);
+    let mut phi = crate::math::atan2(w.z, w.x);
     if phi < 0.0 {
         phi += 2.0 * PI;
     }

@@ -2,28 +2,33 @@
 //! +Y up; θ from +Y, φ = atan2(z, x) from +X towards +Z; u = φ/2π, v = θ/π (row 0 at the top,
 //! +Y). Jacobian dω/(du dv) = 2π·π·sin θ.
 
+use crate::math::atan2;
+use crate::sampling::warp::cos_sin_turns;
 use glam::Vec3;
 use std::f32::consts::PI;
 
-/// (u, v) ∈ [0, 1)² of a unit direction.
+/// (u, v) ∈ [0, 1)² of a unit direction. atan2 and cos/sin are dibench's own
+/// ([`crate::math::atan2`], [`cos_sin_turns`]): the same bits over lanes and alone, on every C
+/// library.
 pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
-    let mut phi = w.z.atan2(w.x);
+    let mut phi = atan2(w.z, w.x);
     if phi < 0.0 {
         phi += 2.0 * PI;
     }
     // atan2 of (sin θ, cos θ): accurate at the poles, where acos is not.
-    let theta = (w.x * w.x + w.z * w.z).sqrt().atan2(w.y);
+    let theta = atan2((w.x * w.x + w.z * w.z).sqrt(), w.y);
     [below_one(phi / (2.0 * PI)), below_one(theta / PI)]
 }
 
 pub fn uv_to_dir(uv: [f32; 2]) -> Vec3 {
-    let (phi, theta) = (2.0 * PI * uv[0], PI * uv[1]);
-    let s = theta.sin();
-    Vec3::new(s * phi.cos(), theta.cos(), s * phi.sin())
+    let (cos_phi, sin_phi) = cos_sin_turns(uv[0]);
+    // θ = πv is half a turn times v.
+    let (cos_theta, sin_theta) = cos_sin_turns(0.5 * uv[1]);
+    Vec3::new(sin_theta * cos_phi, cos_theta, sin_theta * sin_phi)
 }
 
 pub fn jacobian(uv: [f32; 2]) -> f32 {
-    2.0 * PI * PI * (PI * uv[1]).sin()
+    2.0 * PI * PI * cos_sin_turns(0.5 * uv[1]).1
 }
 
 /// x rounded into [0, 1): 2π/2π can round to 1.
