@@ -131,6 +131,14 @@ fn light_probes_over_lanes_are_the_scalar_ones() {
                 .into_iter()
                 .map(|o| o.apply(LightMethods::BASIC)),
         );
+        if scene.scene.environment.is_some() {
+            // Every representation and sampler (lat/long by hierarchical warping has a
+            // kernel over lanes).
+            sets.extend(dibench::strategy::env_methods().map(|env| LightMethods {
+                env,
+                ..LightMethods::BASIC
+            }));
+        }
         for methods in sets {
             let strategy = format!("{methods:?}");
             let mut bound = BoundLights::bind(&view, default_selector(), methods).unwrap();

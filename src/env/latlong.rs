@@ -4,6 +4,7 @@
 
 use crate::math::atan2;
 use crate::sampling::warp::cos_sin_turns;
+use crate::simd::Vector;
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -21,14 +22,27 @@ pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
 }
 
 pub fn uv_to_dir(uv: [f32; 2]) -> Vec3 {
-    let (cos_phi, sin_phi) = cos_sin_turns(uv[0]);
+    let (x, y, z) = uv_to_dir_lanes(uv[0], uv[1]);
+    Vec3::new(x, y, z)
+}
+
+/// [`uv_to_dir`] of N lanes, (x, y, z).
+#[inline(always)]
+pub fn uv_to_dir_lanes<V: Vector<N>, const N: usize>(u: V, v: V) -> (V, V, V) {
+    let (cos_phi, sin_phi) = cos_sin_turns(u);
     // θ = πv is half a turn times v.
-    let (cos_theta, sin_theta) = cos_sin_turns(0.5 * uv[1]);
-    Vec3::new(sin_theta * cos_phi, cos_theta, sin_theta * sin_phi)
+    let (cos_theta, sin_theta) = cos_sin_turns(V::splat(0.5).mul(v));
+    (sin_theta.mul(cos_phi), cos_theta, sin_theta.mul(sin_phi))
 }
 
 pub fn jacobian(uv: [f32; 2]) -> f32 {
-    2.0 * PI * PI * cos_sin_turns(0.5 * uv[1]).1
+    jacobian_lanes(uv[1])
+}
+
+/// [`jacobian`] of N lanes (it depends on v only).
+#[inline(always)]
+pub fn jacobian_lanes<V: Vector<N>, const N: usize>(v: V) -> V {
+    V::splat(2.0 * PI * PI).mul(cos_sin_turns(V::splat(0.5).mul(v)).1)
 }
 
 /// x rounded into [0, 1): 2π/2π can round to 1.

@@ -20,7 +20,7 @@ pub mod octahedral;
 pub mod texels;
 
 use glam::Vec3;
-pub use texels::{EnvSample, ImportanceMap, TexelMap};
+pub use texels::{EnvLanes, EnvSample, ImportanceMap, TexelMap};
 
 /// A parameterization of the sphere of directions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -3,9 +3,11 @@
 
 use super::cdf::MarginalConditional;
 use super::hierarchical::HierarchicalWarp;
-use super::latlong::below_one;
+use super::latlong::{self, below_one};
 use super::{EnvSampler, Repr};
 use crate::math::luminance;
+use crate::sampling::stream::ONE_MINUS_EPSILON;
+use crate::simd::{Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -57,9 +59,21 @@ impl TexelMap {
 
     /// Texel index of an atlas point.
     pub fn index(&self, uv: [f32; 2]) -> usize {
-        let x = ((uv[0] * self.width as f32) as usize).min(self.width - 1);
-        let y = ((uv[1] * self.height as f32) as usize).min(self.height - 1);
-        y * self.width + x
+        self.index_lanes::<f32, 1>(uv[0], uv[1])[0]
+    }
+
+    /// [`Self::index`] of N lanes.
+    #[inline(always)]
+    pub fn index_lanes<V: Vector<N>, const N: usize>(&self, u: V, v: V) -> [usize; N] {
+        let (mut x, mut y) = ([0.0f32; N], [0.0f32; N]);
+        u.mul(V::splat(self.width as f32)).store(&mut x);
+        v.mul(V::splat(self.height as f32)).store(&mut y);
+        let mut k = [0usize; N];
+        for i in 0..N {
+            k[i] = (y[i] as usize).min(self.height - 1) * self.width
+                + (x[i] as usize).min(self.width - 1);
+        }
+        k
     }
 
     pub fn lookup(&self, w: Vec3) -> Vec3 {
@@ -86,51 +100,106 @@ pub struct EnvSample {
 #[derive(Clone, Debug)]
 pub struct ImportanceMap {
     pub texels: TexelMap,
-    weights: Vec<f64>,
-    total: f64,
-    /// ∫ luminance(L) dω over the sphere (≈ Σ weights / texel count).
+    /// Texel weights luminance · J(centre), scaled so the largest is 1 and rounded to f32:
+    /// both samplers and the pdf use these same values, so a texel is sampled exactly when
+    /// its stated pdf is positive.
+    weights: Vec<f32>,
+    /// Density over the atlas of each texel, (w_k / Σw) · texel count (the sum in f64).
+    density: Vec<f32>,
+    /// ∫ luminance(L) dω over the sphere (≈ Σ weights / texel count, before scaling).
     pub luminance_integral: f64,
     /// None for a black map: nothing to sample.
     cdf: Option<MarginalConditional>,
     hier: Option<HierarchicalWarp>,
 }
 
+/// Environment samples of 16 lanes (structure of arrays); `valid` marks the lanes with one.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EnvLanes {
+    pub valid: u32,
+    pub wi: Soa3,
+    pub radiance: Soa3,
+    pub pdf: [f32; WIDTH],
+}
+
 impl ImportanceMap {
     pub fn new(texels: TexelMap) -> Self {
-        let weights: Vec<f64> = (0..texels.texels.len())
+        let exact: Vec<f64> = (0..texels.texels.len())
             .map(|k| {
                 luminance(texels.texels[k]) as f64 * texels.repr.jacobian(texels.centre(k)) as f64
             })
             .collect();
-        let total: f64 = weights.iter().sum();
-        let cdf = MarginalConditional::new(&weights, texels.width);
+        let max = exact.iter().fold(0.0f64, |m, &w| m.max(w));
+        let scale = if max > 0.0 { 1.0 / max } else { 0.0 };
+        let weights: Vec<f32> = exact.iter().map(|&w| (w * scale) as f32).collect();
+        let total: f64 = weights.iter().map(|&w| w as f64).sum();
+        let count = weights.len() as f64;
+        let density = weights
+            .iter()
+            .map(|&w| {
+                if total > 0.0 {
+                    (w as f64 / total * count) as f32
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let as_f64: Vec<f64> = weights.iter().map(|&w| w as f64).collect();
+        let cdf = MarginalConditional::new(&as_f64, texels.width);
         let hier = HierarchicalWarp::new(&weights, texels.repr.tiles(), texels.height);
         ImportanceMap {
-            luminance_integral: total / weights.len() as f64,
+            luminance_integral: exact.iter().sum::<f64>() / count,
             weights,
-            total,
+            density,
             cdf,
             hier,
             texels,
         }
     }
 
-    /// Density over the atlas of texel k: (w_k / Σw) · texel count.
-    fn pdf_uv(&self, k: usize) -> f64 {
-        self.weights[k] / self.total * self.weights.len() as f64
+    /// The atlas points (u, v) ∈ [0, 1)² of N lanes' hierarchical samples, in f32.
+    #[inline(always)]
+    fn hier_uv<V: Vector<N>, const N: usize>(
+        hier: &HierarchicalWarp,
+        t: &TexelMap,
+        u0: V,
+        u1: V,
+    ) -> (V, V) {
+        let s = hier.sample_lanes::<V, N>(u0, u1);
+        let (mut col, mut row) = ([0.0f32; N], [0.0f32; N]);
+        for i in 0..N {
+            col[i] = s.col[i] as f32;
+            row[i] = s.row[i] as f32;
+        }
+        let below = V::splat(ONE_MINUS_EPSILON);
+        (
+            V::load(&col)
+                .add(s.du)
+                .div(V::splat(t.width as f32))
+                .min(below),
+            V::load(&row)
+                .add(s.dv)
+                .div(V::splat(t.height as f32))
+                .min(below),
+        )
     }
 
     /// None for a black map, and for the measure-zero atlas points where J = 0 (lat/long poles).
     pub fn sample(&self, sampler: EnvSampler, u: [f32; 2]) -> Option<EnvSample> {
-        let ((col, row), [du, dv]) = match sampler {
-            EnvSampler::Cdf => self.cdf.as_ref()?.sample(u),
-            EnvSampler::Hierarchical => self.hier.as_ref()?.sample(u),
-        };
         let t = &self.texels;
-        let uv = [
-            below_one(((col as f64 + du) / t.width as f64) as f32),
-            below_one(((row as f64 + dv) / t.height as f64) as f32),
-        ];
+        let uv = match sampler {
+            EnvSampler::Cdf => {
+                let ((col, row), [du, dv]) = self.cdf.as_ref()?.sample(u);
+                [
+                    below_one(((col as f64 + du) / t.width as f64) as f32),
+                    below_one(((row as f64 + dv) / t.height as f64) as f32),
+                ]
+            }
+            EnvSampler::Hierarchical => {
+                let (u, v) = Self::hier_uv::<f32, 1>(self.hier.as_ref()?, t, u[0], u[1]);
+                [u, v]
+            }
+        };
         // The texel of the f32 point (rounding can move a point on an edge next door), so
         // radiance and pdf are those a lookup of the same point gives.
         let k = t.index(uv);
@@ -141,20 +210,50 @@ impl ImportanceMap {
         Some(EnvSample {
             wi: t.repr.uv_to_dir(uv),
             radiance: t.texels[k],
-            pdf: (self.pdf_uv(k) / jac as f64) as f32,
+            pdf: self.density[k] / jac,
         })
+    }
+
+    /// [`Self::sample`] by hierarchical warping for the lanes of `active`, over lanes, for the
+    /// lat/long representation: lane i is [`Self::sample`] of lane i, bit for bit. None when
+    /// this map is not lat/long (its maps are scalar) or black.
+    #[inline(always)]
+    pub fn sample_latlong_hier_lanes<V: Vector<WIDTH>>(
+        &self,
+        u0: V,
+        u1: V,
+        active: u32,
+    ) -> Option<EnvLanes> {
+        let t = &self.texels;
+        if t.repr != Repr::LatLong {
+            return None;
+        }
+        let (u, v) = Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, u0, u1);
+        let k = t.index_lanes::<V, WIDTH>(u, v);
+        let jac = latlong::jacobian_lanes(v);
+        let (x, y, z) = latlong::uv_to_dir_lanes(u, v);
+        let mut out = EnvLanes::default();
+        V3 { x, y, z }.store(&mut out.wi);
+        let mut density = [0.0f32; WIDTH];
+        let mut positive = 0u32;
+        for i in 0..WIDTH {
+            out.radiance.set(i, t.texels[k[i]]);
+            density[i] = self.density[k[i]];
+            positive |= ((self.weights[k[i]] > 0.0) as u32) << i;
+        }
+        let zero = V::splat(0.0);
+        out.valid = active & positive & !jac.le(zero);
+        V::load(&density).div(jac).store(&mut out.pdf);
+        Some(out)
     }
 
     /// Solid-angle pdf of direction `w`: 0 for a black map, in black texels and at J = 0.
     pub fn pdf(&self, w: Vec3) -> f32 {
-        if self.total <= 0.0 {
-            return 0.0;
-        }
         let uv = self.texels.repr.dir_to_uv(w);
         let jac = self.texels.repr.jacobian(uv);
         if jac <= 0.0 {
             return 0.0;
         }
-        (self.pdf_uv(self.texels.index(uv)) / jac as f64) as f32
+        self.density[self.texels.index(uv)] / jac
     }
 }

@@ -3,8 +3,12 @@
 //! (`crate::env`). Like a directional light it is distant: its shadow rays are unbounded.
 
 use super::bounds::{Bounds, DistantBounds};
-use super::{Light, LightCtx, LightHit, LightMethods, LightSample, LightShape};
-use crate::env::{EnvMethod, Environment, Repr};
+use super::{
+    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
+    sample_lane_by_lane,
+};
+use crate::env::{EnvLanes, EnvMethod, EnvSampler, Environment, ImportanceMap, Repr};
+use crate::simd::{self, Isa, Kernel, Lanes, Soa3, Vector, WIDTH};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -54,6 +58,54 @@ impl Light for EnvironmentLight {
 
     fn sample(&self, _ctx: &LightCtx, u: [f32; 3], m: &LightMethods) -> Option<LightSample> {
         self.sample_env([u[0], u[1]], m.env)
+    }
+
+    /// Over lanes for lat/long maps sampled hierarchically (the pair Mitsuba 3's `envmap`
+    /// uses); lane by lane otherwise.
+    fn sample_lanes(
+        &self,
+        isa: Isa,
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        out: &mut LaneSamples,
+    ) {
+        if m.env.repr != Repr::LatLong || m.env.sampler != EnvSampler::Hierarchical {
+            return sample_lane_by_lane(self, q, active, m, out);
+        }
+        struct Hier<'a>(&'a ImportanceMap, &'a LaneQuery, u32);
+        impl Kernel for Hier<'_> {
+            type Out = Option<EnvLanes>;
+            #[inline(always)]
+            fn run<L: Lanes>(self) -> Option<EnvLanes> {
+                let (u0, u1) = (L::V::load(&self.1.u[0]), L::V::load(&self.1.u[1]));
+                self.0.sample_latlong_hier_lanes::<L::V>(u0, u1, self.2)
+            }
+        }
+        let map = self.env.map(Repr::LatLong);
+        let Some(s) = simd::run(isa, Hier(map, q, active)) else {
+            out.valid &= !active; // a black map: nothing to sample
+            return;
+        };
+        let keep = |from: &Soa3, to: &mut Soa3| {
+            for lane in 0..WIDTH {
+                if active >> lane & 1 != 0 {
+                    to.set(lane, from.get(lane));
+                }
+            }
+        };
+        keep(&s.wi, &mut out.wi);
+        keep(&s.radiance, &mut out.radiance);
+        keep(&Soa3::default(), &mut out.point);
+        keep(&Soa3::default(), &mut out.normal);
+        keep(&Soa3::default(), &mut out.point_error);
+        for lane in 0..WIDTH {
+            if active >> lane & 1 != 0 {
+                out.pdf[lane] = s.pdf[lane];
+            }
+        }
+        out.valid = (out.valid & !active) | s.valid;
+        out.distant |= active;
     }
 
     /// By direction: the environment has no points.
