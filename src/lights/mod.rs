@@ -27,7 +27,7 @@ crate::plugin::registry! {
 use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
-use crate::simd::{Isa, Soa3, WIDTH};
+use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
 use bounds::Bounds;
 use glam::Vec3;
 use selector::{LightSelector, SELECTORS, SelectorType};
@@ -350,6 +350,12 @@ impl LaneSamples {
             distant: self.distant >> lane & 1 != 0,
         })
     }
+}
+
+/// Stores lanes `m` of `new` into `old`, keeping its other lanes.
+#[inline(always)]
+pub(crate) fn keep<V: Vector<WIDTH>>(m: u32, new: V3<V>, old: &mut Soa3) {
+    V3::select(m, new, V3::load(old)).store(old)
 }
 
 /// How many f32 a light's [`LaneKernel`] record holds.

@@ -5,12 +5,12 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
-    QuadMethod, direction_to, sample_lane_by_lane,
+    QuadMethod, direction_to, keep, sample_lane_by_lane,
 };
 use crate::math::gamma;
 use crate::math::luminance;
 use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
-use crate::simd::{self, Isa, Kernel, Lanes, Soa3, V3, Vector, WIDTH};
+use crate::simd::{self, Isa, Kernel, Lanes, V3, Vector, WIDTH};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -159,12 +159,6 @@ impl QuadLight {
     pub fn is_rectangle(&self) -> bool {
         self.edge_u.dot(self.edge_v).abs() <= 1e-5 * self.edge_u.length() * self.edge_v.length()
     }
-}
-
-/// Stores lanes `m` of `new` into `old`, keeping its other lanes.
-#[inline(always)]
-fn keep<V: Vector<WIDTH>>(m: u32, new: V3<V>, old: &mut Soa3) {
-    V3::select(m, new, V3::load(old)).store(old)
 }
 
 impl Light for QuadLight {

@@ -6,13 +6,15 @@
 
 use super::bounds::{Bounds, LightBounds};
 use super::{
-    Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, SphereMethod, direction_to,
+    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
+    SphereMethod, direction_to, keep, sample_lane_by_lane,
 };
-use crate::math::{Frame, luminance};
+use crate::math::{Frame, gamma, luminance};
 use crate::sampling::warp::{
     UNIFORM_SPHERE_PDF, one_minus_cos_from_sin2, sample_uniform_cone, sample_uniform_sphere,
-    uniform_cone_pdf,
+    uniform_cone, uniform_cone_pdf,
 };
+use crate::simd::{self, Isa, Kernel, Lanes, V3, Vector, Vector64, WIDTH};
 use glam::{DVec3, Vec3};
 use std::f32::consts::PI;
 
@@ -78,6 +80,100 @@ impl SphereLight {
             pdf: uniform_cone_pdf(omc_max as f32),
             distant: false,
         })
+    }
+
+    /// [`Self::sample_cone`] for the lanes of `a` whose point is outside the sphere, over lanes,
+    /// the same operations in the same order (the f64 parts in f64 lanes); returns the lanes
+    /// of `a` inside it, which the caller samples one at a time. Other lanes of `out` are kept.
+    #[inline(always)]
+    fn sample_cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+        &self,
+        q: &LaneQuery,
+        a: u32,
+        out: &mut LaneSamples,
+    ) -> u32 {
+        let c = self.center.as_dvec3();
+        let r = self.radius as f64;
+        let r2 = r * r;
+        // cone_extent
+        let to_c = [
+            D::splat(c.x).sub(D::from_f32(&q.p.x)),
+            D::splat(c.y).sub(D::from_f32(&q.p.y)),
+            D::splat(c.z).sub(D::from_f32(&q.p.z)),
+        ];
+        let d2 = to_c[0]
+            .mul(to_c[0])
+            .add(to_c[1].mul(to_c[1]))
+            .add(to_c[2].mul(to_c[2]));
+        let inside = a & d2.le(D::splat(r2));
+        let outside = a & !inside;
+        // Lanes inside take 2r² + 1 > r² instead, so that no lane divides by zero or takes a
+        // square root of a negative number; their results are not used.
+        let d2 = D::select(inside, D::splat(2.0 * r2 + 1.0), d2);
+        let one = D::splat(1.0);
+        let omc_max = D::splat(r2)
+            .div(d2)
+            .div(one.add(d2.sub(D::splat(r2)).div(d2).sqrt()));
+        // sample_cone
+        let dc = d2.sqrt();
+        let f32s = |x: D| {
+            let mut a = [0.0f32; WIDTH];
+            x.to_f32(&mut a);
+            V::load(&a)
+        };
+        let axis = V3 {
+            x: f32s(to_c[0].div(dc)),
+            y: f32s(to_c[1].div(dc)),
+            z: f32s(to_c[2].div(dc)),
+        };
+        let (fs, ft) = Frame::from_normal_lanes(axis);
+        let omc32 = f32s(omc_max);
+        let (lx32, ly32, lz32) = uniform_cone(V::load(&q.u[0]), V::load(&q.u[1]), omc32);
+        let d64 = |x: V| {
+            let mut a = [0.0f32; WIDTH];
+            x.store(&mut a);
+            D::from_f32(&a)
+        };
+        let (lx, ly, cos_t) = (d64(lx32), d64(ly32), d64(lz32));
+        let sin2_t = lx.mul(lx).add(ly.mul(ly));
+        let t = d2.sub(D::splat(r * r)).div(
+            dc.mul(cos_t).add(
+                D::splat(r * r)
+                    .sub(d2.mul(sin2_t))
+                    .max(D::splat(0.0))
+                    .sqrt(),
+            ),
+        );
+        let sin_t = sin2_t.sqrt();
+        let sin_a = t.mul(sin_t).div(D::splat(r)).min(one);
+        let cos_a = one.sub(sin_a.mul(sin_a)).sqrt();
+        let turned = D::splat(0.0).lt(sin_t);
+        let den = D::select(turned, sin_t, one);
+        let cos_phi = D::select(turned, lx.div(den), one);
+        let sin_phi = D::select(turned, ly.div(den), D::splat(0.0));
+        let (nx, ny, nz) = (
+            f32s(sin_a.mul(cos_phi)),
+            f32s(sin_a.mul(sin_phi)),
+            f32s(cos_a).neg(),
+        );
+        // Frame::to_world in glam's order.
+        let normal = fs.scale(nx) + ft.scale(ny) + axis.scale(nz);
+        let centre = V3::<V>::splat(self.center);
+        let point = centre + normal.scale(V::splat(self.radius));
+        let wi = fs.scale(lx32) + ft.scale(ly32) + axis.scale(lz32);
+        // Sphere::point_error
+        let error = (point - centre).abs().scale(V::splat(gamma(6)))
+            + V3::splat(self.center.abs()).scale(V::splat(gamma(1)));
+        let pdf = V::splat(1.0).div(V::splat(2.0 * PI).mul(omc32));
+        keep(outside, wi, &mut out.wi);
+        keep(outside, point, &mut out.point);
+        keep(outside, normal, &mut out.normal);
+        keep(outside, error, &mut out.point_error);
+        keep(outside, V3::<V>::splat(self.radiance), &mut out.radiance);
+        V::select(outside, pdf, V::load(&out.pdf)).store(&mut out.pdf);
+        out.valid |= outside;
+        out.distant &= !outside;
+        inside
     }
 
     /// Solid-angle pdf of [`Self::sample_cone`] for the direction from p to the light point q.
@@ -304,6 +400,31 @@ impl Light for SphereLight {
             SphereMethod::Cap => self.sample_cap(ctx.p, u),
             SphereMethod::Cone => self.sample_cone(ctx.p, u),
         }
+    }
+
+    /// Cone sampling over lanes for points outside the sphere; lane by lane otherwise.
+    fn sample_lanes(
+        &self,
+        isa: Isa,
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        out: &mut LaneSamples,
+    ) {
+        if m.sphere != SphereMethod::Cone {
+            return sample_lane_by_lane(self, q, active, m, out);
+        }
+        struct Cone<'a>(&'a SphereLight, &'a LaneQuery, u32, &'a mut LaneSamples);
+        impl Kernel for Cone<'_> {
+            type Out = u32;
+            #[inline(always)]
+            fn run<L: Lanes>(self) -> u32 {
+                self.0
+                    .sample_cone_lanes::<L::V, L::D>(self.1, self.2, self.3)
+            }
+        }
+        let inside = simd::run(isa, Cone(self, q, active, out));
+        sample_lane_by_lane(self, q, inside, m, out);
     }
 
     fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {

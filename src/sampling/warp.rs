@@ -129,11 +129,18 @@ pub fn one_minus_cos_from_sin2(sin2_max: f32) -> f32 {
 /// Uniform direction in the cone about +z with 1 - cos θmax = `one_minus_cos_max`.
 /// Uses t = u·(1 - cos θmax), cos θ = 1 - t, sin²θ = t(2 - t): no 1 - cos² cancellation.
 pub fn sample_uniform_cone(u: [f32; 2], one_minus_cos_max: f32) -> Vec3 {
-    let t = u[0] * one_minus_cos_max;
-    let cos_theta = 1.0 - t;
-    let sin_theta = (t * (2.0 - t)).max(0.0).sqrt();
-    let (c, s) = cos_sin_turns(u[1]);
-    Vec3::new(sin_theta * c, sin_theta * s, cos_theta)
+    let (x, y, z) = uniform_cone(u[0], u[1], one_minus_cos_max);
+    Vec3::new(x, y, z)
+}
+
+/// [`sample_uniform_cone`] over lanes, (x, y, z), each lane with its own cone.
+#[inline(always)]
+pub fn uniform_cone<V: Vector<N>, const N: usize>(u0: V, u1: V, one_minus_cos_max: V) -> (V, V, V) {
+    let t = u0.mul(one_minus_cos_max);
+    let cos_theta = V::splat(1.0).sub(t);
+    let sin_theta = t.mul(V::splat(2.0).sub(t)).max(V::splat(0.0)).sqrt();
+    let (c, s) = cos_sin_turns(u1);
+    (sin_theta.mul(c), sin_theta.mul(s), cos_theta)
 }
 
 /// Solid-angle pdf of [`sample_uniform_cone`] inside the cone (0 outside, which the caller

@@ -18,6 +18,7 @@ pub unsafe fn entry<K: Kernel>(k: K) -> K::Out {
 impl Lanes for Avx2 {
     type V = Y2;
     type W = Y;
+    type D = super::portable::PD<WIDTH>;
 }
 
 /// 8 lanes in one ymm register; also the AVX-512 path's narrow vector. Only ever used inside

@@ -22,6 +22,7 @@ pub unsafe fn entry<K: Kernel>(k: K) -> K::Out {
 impl Lanes for Avx512 {
     type V = Z;
     type W = Y;
+    type D = super::portable::PD<WIDTH>;
 }
 
 #[derive(Clone, Copy)]

@@ -61,12 +61,40 @@ pub trait Vector<const N: usize>: Copy {
     fn reduce_max(self) -> f32;
 }
 
+/// An f64 vector of `N` lanes, for the sample-path code whose numerics need f64 (sphere cones,
+/// ray/sphere roots): the IEEE operations of [`Vector`] (no FMA, MINPD/MAXPD semantics) and
+/// exact conversions from f32 lanes, rounding ones back.
+pub trait Vector64<const N: usize>: Copy {
+    fn splat(x: f64) -> Self;
+    /// Each f32 lane, exactly.
+    fn from_f32(a: &[f32; N]) -> Self;
+    /// Each lane rounded to the nearest f32 (`as f32`).
+    fn to_f32(self, a: &mut [f32; N]);
+    fn add(self, o: Self) -> Self;
+    fn sub(self, o: Self) -> Self;
+    fn mul(self, o: Self) -> Self;
+    fn div(self, o: Self) -> Self;
+    /// `if a < b { a } else { b }` per lane.
+    fn min(self, o: Self) -> Self;
+    /// `if a > b { a } else { b }` per lane.
+    fn max(self, o: Self) -> Self;
+    fn sqrt(self) -> Self;
+    fn lt(self, o: Self) -> u32;
+    fn le(self, o: Self) -> u32;
+    /// Lane i = `a` where bit i of `m` is set, else `b`.
+    fn select(m: u32, a: Self, b: Self) -> Self;
+}
+
 /// One ISA's vector types. A zero-sized type, so a kernel names its ISA once.
 pub trait Lanes: Copy {
     /// 16 lanes: a packet.
     type V: Vector<WIDTH>;
     /// 8 lanes: a wide node's children or a leaf block's triangles.
     type W: Vector<NARROW>;
+    /// 16 f64 lanes. Every ISA uses the portable arrays: inside the ISA's `#[target_feature]`
+    /// entry the compiler turns their lane loops into that ISA's packed f64 instructions
+    /// (checked in the disassembly: `vaddpd`/`vdivpd`/`vsqrtpd` on ymm or zmm registers).
+    type D: Vector64<WIDTH>;
 }
 
 /// A computation generic over the lane types; [`run`] instantiates it for one ISA. Mark `run`

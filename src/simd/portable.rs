@@ -1,6 +1,6 @@
 //! The portable path: plain arrays, scalar code with the same semantics as the SIMD paths.
 
-use super::{Lanes, NARROW, Vector, WIDTH};
+use super::{Lanes, NARROW, Vector, Vector64, WIDTH};
 
 #[derive(Clone, Copy)]
 pub struct Portable;
@@ -8,6 +8,102 @@ pub struct Portable;
 impl Lanes for Portable {
     type V = P<WIDTH>;
     type W = P<NARROW>;
+    type D = PD<WIDTH>;
+}
+
+/// f64 lanes as a plain array: every ISA's [`Lanes::D`] (see there).
+#[derive(Clone, Copy)]
+pub struct PD<const N: usize>([f64; N]);
+
+impl<const N: usize> PD<N> {
+    #[inline(always)]
+    fn map2(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
+        let mut r = [0.0; N];
+        for i in 0..N {
+            r[i] = f(self.0[i], o.0[i]);
+        }
+        PD(r)
+    }
+
+    #[inline(always)]
+    fn bits(self, o: Self, f: impl Fn(f64, f64) -> bool) -> u32 {
+        let mut m = 0;
+        for i in 0..N {
+            m |= (f(self.0[i], o.0[i]) as u32) << i;
+        }
+        m
+    }
+}
+
+impl<const N: usize> Vector64<N> for PD<N> {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        PD([x; N])
+    }
+    #[inline(always)]
+    fn from_f32(a: &[f32; N]) -> Self {
+        let mut r = [0.0; N];
+        for i in 0..N {
+            r[i] = a[i] as f64;
+        }
+        PD(r)
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; N]) {
+        for i in 0..N {
+            a[i] = self.0[i] as f32;
+        }
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.map2(o, |x, y| x + y)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self.map2(o, |x, y| x - y)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.map2(o, |x, y| x * y)
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        self.map2(o, |x, y| x / y)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        self.map2(o, |x, y| if x < y { x } else { y })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        self.map2(o, |x, y| if x > y { x } else { y })
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let mut r = self.0;
+        for x in &mut r {
+            *x = x.sqrt();
+        }
+        PD(r)
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> u32 {
+        self.bits(o, |x, y| x < y)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> u32 {
+        self.bits(o, |x, y| x <= y)
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        // By bit masks, which vectorise into blends (a branch per lane would not).
+        let mut r = [0.0; N];
+        for (i, x) in r.iter_mut().enumerate() {
+            let keep = 0u64.wrapping_sub((m >> i & 1) as u64);
+            *x = f64::from_bits((a.0[i].to_bits() & keep) | (b.0[i].to_bits() & !keep));
+        }
+        PD(r)
+    }
 }
 
 #[derive(Clone, Copy)]
