@@ -2,6 +2,8 @@
 //! samples, never a tessellation, or light and geometry would disagree.
 
 use super::Ray;
+use crate::simd::{Vector64, WIDTH};
+use crate::tracer::RayPacket;
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,6 +52,65 @@ impl Sphere {
         (t32 > 0.0 && t32 < ray.tmax).then_some(t32)
     }
 
+    /// [`Self::intersect`] of the rays of `rays` in lanes `m` (their tmax `tmax`), over f64
+    /// lanes, the same operations in the same order: the lanes that hit, and their t.
+    #[inline(always)]
+    pub fn intersect_lanes<D: Vector64<WIDTH>>(
+        &self,
+        rays: &RayPacket,
+        tmax: &[f32; WIDTH],
+        m: u32,
+    ) -> (u32, [f32; WIDTH]) {
+        let c = self.center.as_dvec3();
+        let f = [
+            D::from_f32(&rays.ox).sub(D::splat(c.x)),
+            D::from_f32(&rays.oy).sub(D::splat(c.y)),
+            D::from_f32(&rays.oz).sub(D::splat(c.z)),
+        ];
+        let dir = [
+            D::from_f32(&rays.dx),
+            D::from_f32(&rays.dy),
+            D::from_f32(&rays.dz),
+        ];
+        let dot = |a: &[D; 3], b: &[D; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
+        let b = dot(&f, &dir).neg();
+        let perp = [
+            f[0].add(dir[0].mul(b)),
+            f[1].add(dir[1].mul(b)),
+            f[2].add(dir[2].mul(b)),
+        ];
+        let r = self.radius as f64;
+        let r2 = D::splat(r * r);
+        let zero = D::splat(0.0);
+        let disc = r2.sub(dot(&perp, &perp));
+        let mut hit = m & !disc.lt(zero);
+        let c = dot(&f, &f).sub(r2);
+        // b.signum(): −1 where the sign bit is set (−0.0 included).
+        let sign = D::select(b.sign(), D::splat(-1.0), D::splat(1.0));
+        let q = b.add(sign.mul(D::select(hit, disc, zero).sqrt()));
+        hit &= !q.eq(zero);
+        let x = c.div(D::select(hit, q, D::splat(1.0)));
+        let near = x.lt(q);
+        let (t0, t1) = (D::select(near, x, q), D::select(near, q, x));
+        let mut tm = [0.0f64; WIDTH];
+        for i in 0..WIDTH {
+            tm[i] = tmax[i] as f64;
+        }
+        let tm = D::from_f64(&tm);
+        let first = zero.lt(t0) & t0.lt(tm);
+        let second = zero.lt(t1) & t1.lt(tm);
+        hit &= first | second;
+        let mut t = [0.0f32; WIDTH];
+        D::select(first, t0, t1).to_f32(&mut t);
+        for (i, &t32) in t.iter().enumerate() {
+            // Rounding to f32 must not carry a hit past tmax or down to 0.
+            if !(t32 > 0.0 && t32 < tmax[i]) {
+                hit &= !(1 << i);
+            }
+        }
+        (hit, t)
+    }
+
     /// Outward unit normal at a point on (or near) the surface.
     pub fn normal_at(&self, p: Vec3) -> Vec3 {
         (p - self.center) / self.radius
@@ -73,6 +134,76 @@ impl Sphere {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::stream::SampleStream;
+    use crate::sampling::warp::sample_uniform_sphere;
+    use crate::simd::{Isa, Kernel, Lanes};
+
+    struct Lanes16<'a>(&'a Sphere, &'a RayPacket, [f32; WIDTH]);
+
+    impl Kernel for Lanes16<'_> {
+        type Out = (u32, [f32; WIDTH]);
+        #[inline(always)]
+        fn run<L: Lanes>(self) -> Self::Out {
+            self.0.intersect_lanes::<L::D>(self.1, &self.2, 0xffff)
+        }
+    }
+
+    /// Sixteen rays at once hit as the scalar test does, with the same t bit for bit, on every
+    /// ISA: rays from outside, inside, on the surface (1e-6 above and below), grazing, aimed
+    /// away, with finite and infinite tmax, and perpendicular ones (f·d = 0, b = −0.0).
+    #[test]
+    fn lanes_are_the_scalar_test_on_every_isa() {
+        let s = Sphere {
+            center: Vec3::new(0.3, -0.2, 1.5),
+            radius: 0.7,
+        };
+        let mut rng = SampleStream::new(5, 8, 1, 3);
+        let (mut hits, mut total) = (0, 0);
+        for round in 0..2000 {
+            let mut rays = RayPacket::default();
+            let mut tmax = [0.0f32; WIDTH];
+            for l in 0..WIDTH {
+                let n = sample_uniform_sphere(rng.next_2d());
+                let o = match (round + l) % 5 {
+                    0 => s.center + n * (s.radius + 1e-6),
+                    1 => s.center + n * (s.radius - 1e-6),
+                    2 => s.center + n * 0.3,
+                    _ => s.center + n * (1.0 + 4.0 * rng.next_1d()),
+                };
+                let mut d = sample_uniform_sphere(rng.next_2d());
+                if l == 7 {
+                    // Perpendicular to the centre direction: f·d = 0.
+                    let f = (o - s.center).normalize();
+                    d = f.any_orthonormal_vector();
+                }
+                let tm = if l % 3 == 0 {
+                    f32::INFINITY
+                } else {
+                    3.0 * rng.next_1d()
+                };
+                rays.set(l, &Ray::new(o, d, tm));
+                tmax[l] = tm;
+            }
+            for isa in Isa::available() {
+                let (mask, t) = crate::simd::run(isa, Lanes16(&s, &rays, tmax));
+                for (l, &t) in t.iter().enumerate() {
+                    let want = s.intersect(&rays.get(l));
+                    let got = (mask >> l & 1 != 0).then_some(t);
+                    assert_eq!(
+                        got.map(f32::to_bits),
+                        want.map(f32::to_bits),
+                        "{isa:?} round {round} lane {l}"
+                    );
+                    hits += want.is_some() as usize;
+                    total += 1;
+                }
+            }
+        }
+        assert!(
+            hits > total / 5 && hits < total * 4 / 5,
+            "{hits} of {total}"
+        );
+    }
 
     #[test]
     fn outside_inside_and_far_small_spheres() {

@@ -66,6 +66,7 @@ pub trait Vector<const N: usize>: Copy {
 /// exact conversions from f32 lanes, rounding ones back.
 pub trait Vector64<const N: usize>: Copy {
     fn splat(x: f64) -> Self;
+    fn from_f64(a: &[f64; N]) -> Self;
     /// Each f32 lane, exactly.
     fn from_f32(a: &[f32; N]) -> Self;
     /// Each lane rounded to the nearest f32 (`as f32`).
@@ -79,8 +80,13 @@ pub trait Vector64<const N: usize>: Copy {
     /// `if a > b { a } else { b }` per lane.
     fn max(self, o: Self) -> Self;
     fn sqrt(self) -> Self;
+    /// The sign bit flipped.
+    fn neg(self) -> Self;
     fn lt(self, o: Self) -> u32;
     fn le(self, o: Self) -> u32;
+    fn eq(self, o: Self) -> u32;
+    /// Lanes whose sign bit is set (-0.0 included).
+    fn sign(self) -> u32;
     /// Lane i = `a` where bit i of `m` is set, else `b`.
     fn select(m: u32, a: Self, b: Self) -> Self;
 }

@@ -41,6 +41,10 @@ impl<const N: usize> Vector64<N> for PD<N> {
         PD([x; N])
     }
     #[inline(always)]
+    fn from_f64(a: &[f64; N]) -> Self {
+        PD(*a)
+    }
+    #[inline(always)]
     fn from_f32(a: &[f32; N]) -> Self {
         let mut r = [0.0; N];
         for i in 0..N {
@@ -87,12 +91,28 @@ impl<const N: usize> Vector64<N> for PD<N> {
         PD(r)
     }
     #[inline(always)]
+    fn neg(self) -> Self {
+        let mut r = self.0;
+        for x in &mut r {
+            *x = -*x;
+        }
+        PD(r)
+    }
+    #[inline(always)]
     fn lt(self, o: Self) -> u32 {
         self.bits(o, |x, y| x < y)
     }
     #[inline(always)]
     fn le(self, o: Self) -> u32 {
         self.bits(o, |x, y| x <= y)
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> u32 {
+        self.bits(o, |x, y| x == y)
+    }
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        self.bits(self, |x, _| x.is_sign_negative())
     }
     #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {

@@ -655,16 +655,15 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
             Kind::Sphere(prim) => {
                 stats.leaves += 1;
                 let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
-                let mut rest = m;
+                let mut tmax = [0.0f32; WIDTH];
+                best.test_tmax::<L::V>().store(&mut tmax);
+                let (mut rest, t) = sphere.intersect_lanes::<L::D>(rays, &tmax, m);
                 while rest != 0 {
                     let l = rest.trailing_zeros() as usize;
                     rest &= rest - 1;
                     let mut b = best.get(l);
-                    let r = rays.get(l);
-                    if let Some(t) = sphere.intersect(&Ray::new(r.origin, r.dir, b.test_tmax())) {
-                        b.offer(t, prim, 0.0, 0.0);
-                        best.put(l, &b);
-                    }
+                    b.offer(t[l], prim, 0.0, 0.0);
+                    best.put(l, &b);
                 }
             }
             Kind::Empty => {}
@@ -772,13 +771,7 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                 Kind::Sphere(prim) => {
                     stats.leaves += 1;
                     let sphere = &g.spheres[g.sphere_index(prim).unwrap()];
-                    while m != 0 {
-                        let l = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        if sphere.intersect(&rays.get(l)).is_some() {
-                            alive &= !(1 << l);
-                        }
-                    }
+                    alive &= !sphere.intersect_lanes::<L::D>(rays, &rays.tmax, m).0;
                 }
                 Kind::Empty => {}
             }
