@@ -132,14 +132,12 @@ impl HierarchicalWarp {
             for i in 0..N {
                 at[i] = tile[i] * self.block + offset + 2 * y[i] as usize * s + 2 * x[i] as usize;
             }
-            let load = |d: usize| {
-                let mut a = [0.0f32; N];
-                for i in 0..N {
-                    a[i] = self.pyramid[at[i] + d];
-                }
-                V::load(&a)
-            };
-            let (c00, c10, c01, c11) = (load(0), load(1), load(s), load(s + 1));
+            let (c00, c10, c01, c11) = (
+                gather::<V, N>(&self.pyramid, &at, 0),
+                gather::<V, N>(&self.pyramid, &at, 1),
+                gather::<V, N>(&self.pyramid, &at, s),
+                gather::<V, N>(&self.pyramid, &at, s + 1),
+            );
             let (right, u0n) = split(c00.add(c01), c10.add(c11), u0);
             let (top, bottom) = (V::select(right, c10, c00), V::select(right, c11, c01));
             let (down, u1n) = split(top, bottom, u1);
@@ -162,6 +160,17 @@ impl HierarchicalWarp {
             dv: u1,
         }
     }
+}
+
+/// Lane i = `values[at[i] + d]`. A function, not a closure: a closure is not always inlined
+/// into the ISA's entry, and outside it its vector load is a call.
+#[inline(always)]
+fn gather<V: Vector<N>, const N: usize>(values: &[f32], at: &[usize; N], d: usize) -> V {
+    let mut a = [0.0f32; N];
+    for i in 0..N {
+        a[i] = values[at[i] + d];
+    }
+    V::load(&a)
 }
 
 /// Per lane, the second half (bit set) with probability b/(a + b), else the first, and u

@@ -116,25 +116,15 @@ impl SphereLight {
             .div(one.add(d2.sub(D::splat(r2)).div(d2).sqrt()));
         // sample_cone
         let dc = d2.sqrt();
-        let f32s = |x: D| {
-            let mut a = [0.0f32; WIDTH];
-            x.to_f32(&mut a);
-            V::load(&a)
-        };
         let axis = V3 {
-            x: f32s(to_c[0].div(dc)),
-            y: f32s(to_c[1].div(dc)),
-            z: f32s(to_c[2].div(dc)),
+            x: f32s::<V, D>(to_c[0].div(dc)),
+            y: f32s::<V, D>(to_c[1].div(dc)),
+            z: f32s::<V, D>(to_c[2].div(dc)),
         };
         let (fs, ft) = Frame::from_normal_lanes(axis);
-        let omc32 = f32s(omc_max);
+        let omc32 = f32s::<V, D>(omc_max);
         let (lx32, ly32, lz32) = uniform_cone(V::load(&q.u[0]), V::load(&q.u[1]), omc32);
-        let d64 = |x: V| {
-            let mut a = [0.0f32; WIDTH];
-            x.store(&mut a);
-            D::from_f32(&a)
-        };
-        let (lx, ly, cos_t) = (d64(lx32), d64(ly32), d64(lz32));
+        let (lx, ly, cos_t) = (d64::<V, D>(lx32), d64::<V, D>(ly32), d64::<V, D>(lz32));
         let sin2_t = lx.mul(lx).add(ly.mul(ly));
         let t = d2.sub(D::splat(r * r)).div(
             dc.mul(cos_t).add(
@@ -152,9 +142,9 @@ impl SphereLight {
         let cos_phi = D::select(turned, lx.div(den), one);
         let sin_phi = D::select(turned, ly.div(den), D::splat(0.0));
         let (nx, ny, nz) = (
-            f32s(sin_a.mul(cos_phi)),
-            f32s(sin_a.mul(sin_phi)),
-            f32s(cos_a).neg(),
+            f32s::<V, D>(sin_a.mul(cos_phi)),
+            f32s::<V, D>(sin_a.mul(sin_phi)),
+            f32s::<V, D>(cos_a).neg(),
         );
         // Frame::to_world in glam's order.
         let normal = fs.scale(nx) + ft.scale(ny) + axis.scale(nz);
@@ -368,6 +358,23 @@ impl SphereLight {
         let cap_area = 2.0 * PI * self.radius * self.radius * (1.0 - self.radius / dc);
         dist2 / (cap_area * cos_l)
     }
+}
+
+/// f64 lanes rounded to f32 lanes. A function, not a closure: a closure is not always inlined
+/// into the ISA's entry, and outside it its vector operations are calls.
+#[inline(always)]
+fn f32s<V: Vector<WIDTH>, D: Vector64<WIDTH>>(x: D) -> V {
+    let mut a = [0.0f32; WIDTH];
+    x.to_f32(&mut a);
+    V::load(&a)
+}
+
+/// f32 lanes, exactly as f64 lanes.
+#[inline(always)]
+fn d64<V: Vector<WIDTH>, D: Vector64<WIDTH>>(x: V) -> D {
+    let mut a = [0.0f32; WIDTH];
+    x.store(&mut a);
+    D::from_f32(&a)
 }
 
 impl Light for SphereLight {
