@@ -14,6 +14,7 @@ use crate::lights::quad::QuadLight;
 use crate::lights::sphere::SphereLight;
 use crate::lights::{EmitterRef, Light, LightSet};
 use crate::scene::Scene;
+use crate::simd::{Isa, Soa3, WIDTH};
 use crate::strategy::Integrand;
 use crate::tracer::bvh::ObvhsTracer;
 use crate::tracer::{Geometry, Tracer};
@@ -69,6 +70,14 @@ impl SceneView<'_> {
     /// Radiance the environment sends along -`dir` (zero without one).
     pub fn env_radiance(&self, dir: Vec3) -> Vec3 {
         self.lights.env_radiance(self.env, dir)
+    }
+
+    /// [`Self::env_radiance`] of the directions `dirs` of lanes `mask`, added to `out` (over
+    /// lanes where the representation has a kernel, with the same bits).
+    pub fn add_env_radiance(&self, isa: Isa, dirs: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
+        if let Some(env) = self.lights.environment() {
+            env.map(self.env).texels.add_lookups(isa, dirs, mask, out);
+        }
     }
 
     /// Radiance an emitter primitive sends back along a ray that hit it.

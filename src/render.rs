@@ -245,15 +245,13 @@ impl<'a> Renderer<'a> {
         // or a sphere hit's point (computed lane by lane: spheres are few).
         let mut g = HitLanes::default();
         let mut hit_mask = 0u32;
+        let mut escaped = 0u32;
         for lane in 0..LANES {
             if active & (1 << lane) == 0 {
                 continue;
             }
             let Some(hit) = hits.get(lane) else {
-                // The camera sees the environment (zero without one).
-                if self.direct {
-                    out.radiance[lane] += self.view.env_radiance(cam.get(lane).dir);
-                }
+                escaped |= 1 << lane;
                 continue;
             };
             hit_mask |= 1 << lane;
@@ -275,6 +273,16 @@ impl<'a> Renderer<'a> {
                     g.given |= 1 << lane;
                 }
             }
+        }
+        if self.direct && escaped != 0 {
+            // The camera sees the environment (zero without one).
+            let dirs = Soa3 {
+                x: cam.dx,
+                y: cam.dy,
+                z: cam.dz,
+            };
+            self.view
+                .add_env_radiance(self.isa, &dirs, escaped, &mut out.radiance);
         }
         if hit_mask == 0 {
             return;
@@ -345,6 +353,23 @@ impl<'a> Renderer<'a> {
         if emit_mask != 0 {
             let mut ehits = HitPacket::default();
             scene.tracer.intersect_packet(&emit, emit_mask, &mut ehits);
+            // What the escaped emission rays see of the environment, looked up over lanes.
+            let mut escaped = 0u32;
+            for lane in 0..LANES {
+                if emit_mask & (1 << lane) != 0 && ehits.get(lane).is_none() {
+                    escaped |= 1 << lane;
+                }
+            }
+            let mut env = [Vec3::ZERO; LANES];
+            if escaped != 0 {
+                let dirs = Soa3 {
+                    x: emit.dx,
+                    y: emit.dy,
+                    z: emit.dz,
+                };
+                self.view
+                    .add_env_radiance(self.isa, &dirs, escaped, &mut env);
+            }
             for lane in 0..LANES {
                 let (Some(probe), Some(sp)) = (probes[lane].emission, &tile.points[lane]) else {
                     continue;
@@ -353,7 +378,7 @@ impl<'a> Renderer<'a> {
                     Some(hit) => {
                         emission_contribution(&self.view, self.estimator(), sp, &probe, &hit)
                     }
-                    None => escape_contribution(&self.view, self.estimator(), sp, &probe),
+                    None => escape_weighted(self.estimator(), sp, &probe, env[lane]),
                 };
             }
         }
@@ -472,7 +497,16 @@ pub fn escape_contribution(
     sp: &ShadingPoint,
     probe: &EmissionProbe,
 ) -> Vec3 {
-    let le = view.env_radiance(probe.ray.dir);
+    escape_weighted(estimator, sp, probe, view.env_radiance(probe.ray.dir))
+}
+
+/// [`escape_contribution`] given the environment's radiance `le` along the probe's ray.
+fn escape_weighted(
+    estimator: &dyn Estimator,
+    sp: &ShadingPoint,
+    probe: &EmissionProbe,
+    le: Vec3,
+) -> Vec3 {
     if le == Vec3::ZERO {
         return Vec3::ZERO;
     }

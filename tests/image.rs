@@ -2,7 +2,8 @@
 //! one shading point: an emitter filling the view renders exactly its radiance and its back
 //! exactly zero; a sub-pixel emitter shows the pixel jitter covers the pixel in both axes;
 //! a wide image maps pixels to the right directions (aspect and field of view); two strategies
-//! that compute the same estimator never share random numbers.
+//! that compute the same estimator never share random numbers; camera rays and BSDF samples
+//! that escape see the environment.
 
 use dibench::film::Film;
 use dibench::prepare::PreparedScene;
@@ -141,4 +142,47 @@ fn strategies_never_share_random_numbers() {
         render(&sc, a.as_ref(), 12, 1).sum,
         "the seed is ignored"
     );
+}
+
+/// The environment through the whole path, camera escapes and BSDF samples that escape: a
+/// camera at height 1 looks along the horizon over a floor (albedo ρ = ½) under a constant
+/// environment L. The top four rows look up, so every strategy sees L there; the bottom three
+/// rows see the floor, whose reflected radiance is ρ·L, and `cosine` estimates it with zero
+/// variance (f·cos/pdf = ρ for every sample, each of which escapes to L). A lane whose escape
+/// were dropped, doubled or given another lane's ray would move a pixel off by a whole term.
+#[test]
+fn the_environment_is_seen_by_camera_rays_and_escaping_samples() {
+    let env = [0.6f32, 0.4, 0.2];
+    let camera = "[camera]\neye = [0.0, 1.0, 0.0]\nlook_at = [0.0, 1.0, -1.0]\nfov_y_deg = 60.0";
+    let body = format!(
+        "[[quad]]\ncorner = [-20.0, 0.0, -40.0]\nedge_u = [0.0, 0.0, 40.0]\nedge_v = [40.0, 0.0, 0.0]\nmaterial = \"m\"\n[environment]\nconstant = {env:?}\n"
+    );
+    let (w, h) = (8usize, 8usize);
+    let sc = scene(camera, (w as u32, h as u32), &body);
+    let close =
+        |got: [f64; 3], want: [f64; 3]| (0..3).all(|c| (got[c] - want[c]).abs() <= 1e-5 * want[c]);
+    let sky = env.map(f64::from);
+    let floor = sky.map(|c| 0.5 * c);
+    let (run, _) = applicable(&sc);
+    assert!(run.iter().any(|s| s.name() == "cosine"));
+    for s in &run {
+        let img = render(&sc, s.as_ref(), 9, 4).mean();
+        for k in 0..4 * w {
+            assert!(
+                close(img.pixels[k], sky),
+                "{}: sky pixel {k}: {:?}",
+                s.name(),
+                img.pixels[k]
+            );
+        }
+        if s.name() == "cosine" {
+            for k in 5 * w..h * w {
+                assert!(
+                    close(img.pixels[k], floor),
+                    "cosine: floor pixel {k}: {:?}",
+                    img.pixels[k]
+                );
+            }
+        }
+    }
 }

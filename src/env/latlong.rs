@@ -12,13 +12,32 @@ use std::f32::consts::PI;
 /// ([`crate::math::atan2`], [`cos_sin_turns`]): the same bits over lanes and alone, on every C
 /// library.
 pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
-    let mut phi = atan2(w.z, w.x);
-    if phi < 0.0 {
-        phi += 2.0 * PI;
-    }
+    let (u, v) = dir_to_uv_lanes(w.x, w.y, w.z);
+    [u, v]
+}
+
+/// [`dir_to_uv`] of N lanes' directions (x, y, z).
+#[inline(always)]
+pub fn dir_to_uv_lanes<V: Vector<N>, const N: usize>(x: V, y: V, z: V) -> (V, V) {
+    let phi = atan2(z, x);
+    let phi = V::select(phi.lt(V::splat(0.0)), phi.add(V::splat(2.0 * PI)), phi);
     // atan2 of (sin θ, cos θ): accurate at the poles, where acos is not.
-    let theta = atan2((w.x * w.x + w.z * w.z).sqrt(), w.y);
-    [below_one(phi / (2.0 * PI)), below_one(theta / PI)]
+    let theta = atan2(x.mul(x).add(z.mul(z)).sqrt(), y);
+    (
+        below_one_lanes(phi.div(V::splat(2.0 * PI))),
+        below_one_lanes(theta.div(V::splat(PI))),
+    )
+}
+
+/// [`below_one`] of N lanes, the same comparisons.
+#[inline(always)]
+fn below_one_lanes<V: Vector<N>, const N: usize>(x: V) -> V {
+    let top = V::splat(crate::sampling::stream::ONE_MINUS_EPSILON);
+    V::select(
+        x.lt(V::splat(0.0)),
+        V::splat(0.0),
+        V::select(top.lt(x), top, x),
+    )
 }
 
 pub fn uv_to_dir(uv: [f32; 2]) -> Vec3 {

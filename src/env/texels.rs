@@ -7,7 +7,7 @@ use super::latlong::{self, below_one};
 use super::{EnvSampler, Repr};
 use crate::math::luminance;
 use crate::sampling::stream::ONE_MINUS_EPSILON;
-use crate::simd::{Soa3, V3, Vector, WIDTH};
+use crate::simd::{self, Isa, Kernel, Lanes, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -78,6 +78,35 @@ impl TexelMap {
 
     pub fn lookup(&self, w: Vec3) -> Vec3 {
         self.texels[self.index(self.repr.dir_to_uv(w))]
+    }
+
+    /// [`Self::lookup`] of the directions `w` of lanes `mask`, added to `out`: over lanes for
+    /// lat/long maps (bit for bit), lane by lane for the others.
+    pub fn add_lookups(&self, isa: Isa, w: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
+        if self.repr != Repr::LatLong {
+            for (lane, o) in out.iter_mut().enumerate() {
+                if mask >> lane & 1 != 0 {
+                    *o += self.lookup(w.get(lane));
+                }
+            }
+            return;
+        }
+        struct Index<'a>(&'a TexelMap, &'a Soa3);
+        impl Kernel for Index<'_> {
+            type Out = [usize; WIDTH];
+            #[inline(always)]
+            fn run<L: Lanes>(self) -> [usize; WIDTH] {
+                let w = V3::<L::V>::load(self.1);
+                let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
+                self.0.index_lanes::<L::V, WIDTH>(u, v)
+            }
+        }
+        let k = simd::run(isa, Index(self, w));
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0 {
+                *o += self.texels[k[lane]];
+            }
+        }
     }
 
     /// Atlas centre of texel k.
@@ -255,5 +284,77 @@ impl ImportanceMap {
             return 0.0;
         }
         self.density[self.texels.index(uv)] / jac
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::stream::SampleStream;
+
+    /// Radiance that differs in every texel, so a lookup one texel off shows.
+    fn map(repr: Repr) -> TexelMap {
+        let mut m = TexelMap::resample(repr, 8, &|_| Vec3::ZERO);
+        for (k, t) in m.texels.iter_mut().enumerate() {
+            *t = Vec3::new(k as f32 + 1.0, 0.5 * k as f32, 1.0);
+        }
+        m
+    }
+
+    /// Sixteen lookups at once are the scalar ones, bit for bit, on every ISA and for every
+    /// representation, with the poles, the axes and both sides of the lat/long seam among the
+    /// directions, and only the masked lanes added.
+    #[test]
+    fn lookups_over_lanes_are_the_scalar_ones_on_every_isa() {
+        let special = [
+            Vec3::X,
+            -Vec3::X,
+            Vec3::Y,
+            -Vec3::Y,
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(-1.0, 0.0, -0.0),
+            Vec3::new(-1.0, 0.0, 1e-8).normalize(),
+            Vec3::new(-1.0, 0.0, -1e-8).normalize(),
+            Vec3::new(1e-7, 1.0, 0.0).normalize(),
+            Vec3::new(0.0, -1.0, 1e-7).normalize(),
+        ];
+        let mut rng = SampleStream::new(4, 1, 2, 3);
+        for repr in Repr::ALL {
+            let m = map(repr);
+            for round in 0..300 {
+                let mut w = Soa3::default();
+                for lane in 0..WIDTH {
+                    let d = if round % 3 == 0 {
+                        special[(lane + round) % special.len()]
+                    } else {
+                        crate::sampling::warp::sample_uniform_sphere(rng.next_2d())
+                    };
+                    w.set(lane, d);
+                }
+                let mask = if round % 2 == 0 {
+                    u32::MAX >> (32 - WIDTH)
+                } else {
+                    (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
+                };
+                for isa in Isa::available() {
+                    let mut out = [Vec3::splat(0.25); WIDTH];
+                    m.add_lookups(isa, &w, mask, &mut out);
+                    for (lane, o) in out.iter().enumerate() {
+                        let want = if mask >> lane & 1 != 0 {
+                            Vec3::splat(0.25) + m.lookup(w.get(lane))
+                        } else {
+                            Vec3::splat(0.25)
+                        };
+                        assert_eq!(
+                            o.to_array().map(f32::to_bits),
+                            want.to_array().map(f32::to_bits),
+                            "{isa:?} {repr:?} lane {lane} w {:?}",
+                            w.get(lane)
+                        );
+                    }
+                }
+            }
+        }
     }
 }
