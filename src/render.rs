@@ -361,6 +361,7 @@ impl<'a> Renderer<'a> {
                 }
             }
             let mut env = [Vec3::ZERO; LANES];
+            let mut env_weight = [0.0f32; LANES];
             if escaped != 0 {
                 let dirs = Soa3 {
                     x: emit.dx,
@@ -369,6 +370,9 @@ impl<'a> Renderer<'a> {
                 };
                 self.view
                     .add_env_radiance(self.isa, &dirs, escaped, &mut env);
+                env_weight =
+                    self.estimator()
+                        .env_weight_packet(&tile.points, &probes, &dirs, escaped);
             }
             for lane in 0..LANES {
                 let (Some(probe), Some(sp)) = (probes[lane].emission, &tile.points[lane]) else {
@@ -378,7 +382,7 @@ impl<'a> Renderer<'a> {
                     Some(hit) => {
                         emission_contribution(&self.view, self.estimator(), sp, &probe, &hit)
                     }
-                    None => escape_weighted(self.estimator(), sp, &probe, env[lane]),
+                    None => escape_weighted(&probe, env[lane], env_weight[lane]),
                 };
             }
         }
@@ -497,20 +501,20 @@ pub fn escape_contribution(
     sp: &ShadingPoint,
     probe: &EmissionProbe,
 ) -> Vec3 {
-    escape_weighted(estimator, sp, probe, view.env_radiance(probe.ray.dir))
-}
-
-/// [`escape_contribution`] given the environment's radiance `le` along the probe's ray.
-fn escape_weighted(
-    estimator: &dyn Estimator,
-    sp: &ShadingPoint,
-    probe: &EmissionProbe,
-    le: Vec3,
-) -> Vec3 {
+    let le = view.env_radiance(probe.ray.dir);
     if le == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    probe.weight * le * estimator.env_weight(sp, probe)
+    escape_weighted(probe, le, estimator.env_weight(sp, probe))
+}
+
+/// [`escape_contribution`] given the environment's radiance `le` along the probe's ray and
+/// the estimator's weight `w` for it.
+fn escape_weighted(probe: &EmissionProbe, le: Vec3, w: f32) -> Vec3 {
+    if le == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    probe.weight * le * w
 }
 
 /// What an emission probe that hit `hit` adds: weight · Le · the estimator's MIS weight.

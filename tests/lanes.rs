@@ -11,7 +11,7 @@ use dibench::render::camera_ray;
 use dibench::sampling::Dims;
 use dibench::sampling::stream::SampleStream;
 use dibench::scene::Scene;
-use dibench::simd::Isa;
+use dibench::simd::{Isa, Soa3};
 use dibench::strategy::light_sampling::{BoundLights, LightProbe};
 use dibench::strategy::{Probes, ShadingPoint, by_name};
 use dibench::tracer::LANES;
@@ -224,4 +224,63 @@ fn estimators_packets_are_their_samples() {
             }
         }
     }
+}
+
+/// The MIS weights of emission probes that escape, over lanes
+/// ([`Estimator::env_weight_packet`]), equal [`Estimator::env_weight`] lane by lane, bit for
+/// bit, for every environment representation and sampler, on every scene with an environment.
+#[test]
+fn env_weights_over_lanes_are_the_scalar_ones() {
+    let mut checked = 0;
+    for (name, scene) in scenes() {
+        if scene.lights.environment().is_none() {
+            continue;
+        }
+        let packets = packets(&scene, 24);
+        for strategy in [
+            "mis-power",
+            "mis-env-latlong-cdf",
+            "mis-env-latlong-hier",
+            "mis-env-cube-hier",
+            "mis-env-octa-cdf",
+            "mis-env-healpix-hier",
+            "cosine",
+        ] {
+            let s = by_name(strategy).unwrap();
+            // `mis-power` is the same as `mis-env-latlong-cdf` where the environment is the only
+            // light, and is not bound there.
+            let Ok(est) = s.bind(scene.view(s.integrand())) else {
+                continue;
+            };
+            for (points, values) in &packets {
+                let mut probes = [Probes::default(); LANES];
+                let mut u = dims(values);
+                est.sample_packet(points, &mut u, &mut probes);
+                let mut dirs = Soa3::default();
+                let mut mask = 0u32;
+                for lane in 0..LANES {
+                    if let (Some(_), Some(e)) = (&points[lane], &probes[lane].emission) {
+                        dirs.set(lane, e.ray.dir);
+                        mask |= 1 << lane;
+                    }
+                }
+                let got = est.env_weight_packet(points, &probes, &dirs, mask);
+                for lane in 0..LANES {
+                    if mask >> lane & 1 == 0 {
+                        continue;
+                    }
+                    let (sp, e) = (points[lane].as_ref().unwrap(), &probes[lane].emission);
+                    let want = est.env_weight(sp, e.as_ref().unwrap());
+                    assert_eq!(
+                        got[lane].to_bits(),
+                        want.to_bits(),
+                        "{name} {strategy} lane {lane}: {} against {want}",
+                        got[lane]
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 1000, "{checked}");
 }

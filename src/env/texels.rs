@@ -285,6 +285,46 @@ impl ImportanceMap {
         }
         self.density[self.texels.index(uv)] / jac
     }
+
+    /// [`Self::pdf`] of the directions `w` of lanes `mask` (0 in the others): over lanes for
+    /// lat/long maps (bit for bit), lane by lane for the others.
+    pub fn pdf_lanes(&self, isa: Isa, w: &Soa3, mask: u32) -> [f32; WIDTH] {
+        let mut out = [0.0f32; WIDTH];
+        if self.texels.repr != Repr::LatLong {
+            for (lane, o) in out.iter_mut().enumerate() {
+                if mask >> lane & 1 != 0 {
+                    *o = self.pdf(w.get(lane));
+                }
+            }
+            return out;
+        }
+        struct Pdf<'a>(&'a ImportanceMap, &'a Soa3, u32);
+        impl Kernel for Pdf<'_> {
+            type Out = [f32; WIDTH];
+            #[inline(always)]
+            fn run<L: Lanes>(self) -> [f32; WIDTH] {
+                let (map, mask) = (self.0, self.2);
+                let w = V3::<L::V>::load(self.1);
+                let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
+                let jac = latlong::jacobian_lanes(v);
+                let k = map.texels.index_lanes::<L::V, WIDTH>(u, v);
+                let mut density = [0.0f32; WIDTH];
+                for lane in 0..WIDTH {
+                    if mask >> lane & 1 != 0 {
+                        density[lane] = map.density[k[lane]];
+                    }
+                }
+                // J ≤ 0 (at the poles) has pdf 0, as in the scalar pdf; other lanes divide by 1.
+                let zero = L::V::splat(0.0);
+                let positive = zero.lt(jac);
+                let pdf = L::V::load(&density).div(L::V::select(positive, jac, L::V::splat(1.0)));
+                let mut out = [0.0f32; WIDTH];
+                L::V::select(positive, pdf, zero).store(&mut out);
+                out
+            }
+        }
+        simd::run(isa, Pdf(self, w, mask))
+    }
 }
 
 #[cfg(test)]
@@ -301,12 +341,9 @@ mod tests {
         m
     }
 
-    /// Sixteen lookups at once are the scalar ones, bit for bit, on every ISA and for every
-    /// representation, with the poles, the axes and both sides of the lat/long seam among the
-    /// directions, and only the masked lanes added.
-    #[test]
-    fn lookups_over_lanes_are_the_scalar_ones_on_every_isa() {
-        let special = [
+    /// Directions where lookups are delicate: the poles, the axes, both sides of the seam.
+    fn special() -> [Vec3; 11] {
+        [
             Vec3::X,
             -Vec3::X,
             Vec3::Y,
@@ -318,7 +355,63 @@ mod tests {
             Vec3::new(-1.0, 0.0, -1e-8).normalize(),
             Vec3::new(1e-7, 1.0, 0.0).normalize(),
             Vec3::new(0.0, -1.0, 1e-7).normalize(),
-        ];
+        ]
+    }
+
+    /// Sixteen pdfs at once are the scalar ones, bit for bit, on every ISA and for every
+    /// representation (poles, axes, the seam, black texels among them), 0 outside the mask.
+    #[test]
+    fn pdfs_over_lanes_are_the_scalar_ones_on_every_isa() {
+        let mut rng = SampleStream::new(5, 1, 2, 3);
+        for repr in Repr::ALL {
+            let mut texels = map(repr);
+            for (k, t) in texels.texels.iter_mut().enumerate() {
+                if k % 7 == 3 {
+                    *t = Vec3::ZERO;
+                }
+            }
+            let m = ImportanceMap::new(texels);
+            for round in 0..300 {
+                let mut w = Soa3::default();
+                for lane in 0..WIDTH {
+                    let d = if round % 3 == 0 {
+                        special()[(lane + round) % special().len()]
+                    } else {
+                        crate::sampling::warp::sample_uniform_sphere(rng.next_2d())
+                    };
+                    w.set(lane, d);
+                }
+                let mask = if round % 2 == 0 {
+                    u32::MAX >> (32 - WIDTH)
+                } else {
+                    (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
+                };
+                for isa in Isa::available() {
+                    let got = m.pdf_lanes(isa, &w, mask);
+                    for (lane, g) in got.iter().enumerate() {
+                        let want = if mask >> lane & 1 != 0 {
+                            m.pdf(w.get(lane))
+                        } else {
+                            0.0
+                        };
+                        assert_eq!(
+                            g.to_bits(),
+                            want.to_bits(),
+                            "{isa:?} {repr:?} lane {lane} w {:?}",
+                            w.get(lane)
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sixteen lookups at once are the scalar ones, bit for bit, on every ISA and for every
+    /// representation, with the poles, the axes and both sides of the lat/long seam among the
+    /// directions, and only the masked lanes added.
+    #[test]
+    fn lookups_over_lanes_are_the_scalar_ones_on_every_isa() {
+        let special = special();
         let mut rng = SampleStream::new(4, 1, 2, 3);
         for repr in Repr::ALL {
             let m = map(repr);

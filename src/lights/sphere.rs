@@ -587,3 +587,100 @@ fn chi2_case(
         chart: Chart::cap(-center, 1.0 - r as f64 / center.length() as f64 + 1e-3),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lights::{Light, LightMethods};
+    use crate::sampling::stream::ONE_MINUS_EPSILON;
+    use crate::sampling::stream::SampleStream;
+
+    fn bits(s: Option<LightSample>) -> Option<[u32; 16]> {
+        s.map(|s| {
+            let mut b = [0u32; 16];
+            for (k, v) in [s.wi, s.point, s.normal, s.point_error, s.radiance]
+                .iter()
+                .flat_map(|v| v.to_array())
+                .chain([s.pdf])
+                .enumerate()
+            {
+                b[k] = v.to_bits();
+            }
+            b
+        })
+    }
+
+    /// Cone samples of sixteen lanes at once are the scalar ones, bit for bit, on every ISA:
+    /// points far away, 1e-6 off the surface, on it and inside (lane by lane there), with u at
+    /// 0 and just below 1 among the numbers; lanes outside the mask keep what they held.
+    #[test]
+    fn cone_lanes_are_the_scalar_samples_on_every_isa() {
+        let light = SphereLight {
+            center: Vec3::new(0.3, -0.2, 1.1),
+            radius: 0.7,
+            radiance: Vec3::new(2.0, 1.0, 0.5),
+        };
+        let m = LightMethods::BASIC;
+        let mut rng = SampleStream::new(3, 1, 4, 1);
+        for round in 0..400 {
+            let mut q = LaneQuery {
+                p: Default::default(),
+                n: Default::default(),
+                u: [[0.0; WIDTH]; 3],
+            };
+            for lane in 0..WIDTH {
+                let [a, b] = rng.next_2d();
+                let dir = crate::sampling::warp::sample_uniform_sphere([a, b]);
+                let dist = match (lane + round) % 5 {
+                    0 => 50.0,
+                    1 => light.radius * (1.0 + 1e-6),
+                    2 => light.radius,
+                    3 => 0.5 * light.radius,
+                    _ => light.radius * (1.0 + 3.0 * rng.next_2d()[0]),
+                };
+                q.p.set(lane, light.center + dir * dist);
+                q.n.set(lane, -dir);
+                let [u0, u1] = rng.next_2d();
+                let special = [0.0, ONE_MINUS_EPSILON, u0, u1];
+                q.u[0][lane] = special[(lane + round) % 4];
+                q.u[1][lane] = special[(lane + 2 * round) % 4];
+                q.u[2][lane] = rng.next_2d()[0];
+            }
+            let active = if round % 2 == 0 {
+                u32::MAX >> (32 - WIDTH)
+            } else {
+                (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
+            };
+            for isa in Isa::available() {
+                let mut out = LaneSamples::default();
+                let marker = LightSample {
+                    wi: Vec3::X,
+                    point: Vec3::Y,
+                    normal: Vec3::Z,
+                    point_error: Vec3::ONE,
+                    radiance: Vec3::splat(7.0),
+                    pdf: 3.0,
+                    distant: true,
+                };
+                for lane in 0..WIDTH {
+                    out.set(lane, Some(marker));
+                }
+                light.sample_lanes(isa, &q, active, &m, &mut out);
+                for lane in 0..WIDTH {
+                    let want = if active >> lane & 1 != 0 {
+                        light.sample(&q.ctx(lane), [q.u[0][lane], q.u[1][lane], q.u[2][lane]], &m)
+                    } else {
+                        Some(marker)
+                    };
+                    let got = out.get(lane);
+                    assert_eq!(
+                        (bits(got), got.map(|s| s.distant)),
+                        (bits(want), want.map(|s| s.distant)),
+                        "{isa:?} round {round} lane {lane} p {:?}",
+                        q.p.get(lane)
+                    );
+                }
+            }
+        }
+    }
+}

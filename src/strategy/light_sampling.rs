@@ -343,6 +343,33 @@ impl<'s> BoundLights<'s> {
         self.lights
             .env_pdf(self.selector, &sp.light_ctx(), wi, &self.methods)
     }
+
+    /// [`Self::env_pdf`] of the directions `dirs` from the points of lanes `mask` (0 in the
+    /// others): the environment's pdf over lanes, each lane's selection pmf after it, in the
+    /// scalar order (pmf · pdf).
+    pub fn env_pdf_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        dirs: &Soa3,
+        mask: u32,
+    ) -> [f32; LANES] {
+        let mut out = [0.0f32; LANES];
+        let (Some(i), Some(env)) = (self.lights.environment_index(), self.lights.environment())
+        else {
+            return out;
+        };
+        let pdf = env
+            .map(self.methods.env.repr)
+            .pdf_lanes(self.isa, dirs, mask);
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0
+                && let Some(sp) = &points[lane]
+            {
+                *o = self.selector.pmf(&sp.light_ctx(), i) * pdf[lane];
+            }
+        }
+        out
+    }
 }
 
 /// A strategy's name with its light selector appended when it is not the default one:

@@ -17,6 +17,7 @@ use crate::lights::selector::{SelectorType, default_selector};
 use crate::lights::{LightMethods, LightShape};
 use crate::prepare::{SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout};
+use crate::simd::Soa3;
 use crate::tracer::LANES;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -300,6 +301,25 @@ impl Estimator for MisEstimator<'_> {
     fn env_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe) -> f32 {
         let p_light = self.lights.env_pdf(sp, probe.ray.dir);
         self.strategy.heuristic.weight(probe.pdf, p_light)
+    }
+
+    fn env_weight_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        probes: &[Probes; LANES],
+        dirs: &Soa3,
+        mask: u32,
+    ) -> [f32; LANES] {
+        let p_light = self.lights.env_pdf_packet(points, dirs, mask);
+        let mut out = [1.0f32; LANES];
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0
+                && let Some(probe) = &probes[lane].emission
+            {
+                *o = self.strategy.heuristic.weight(probe.pdf, p_light[lane]);
+            }
+        }
+        out
     }
 }
 

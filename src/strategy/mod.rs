@@ -270,6 +270,27 @@ pub trait Estimator: Send + Sync {
         1.0
     }
 
+    /// [`Self::env_weight`] of the emission probes of lanes `mask`, whose rays' directions are
+    /// `dirs` (the renderer's packet of escaped rays), lane by lane unless overridden; lanes
+    /// outside `mask` are not read.
+    fn env_weight_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        probes: &[Probes; LANES],
+        _dirs: &Soa3,
+        mask: u32,
+    ) -> [f32; LANES] {
+        let mut out = [1.0f32; LANES];
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0
+                && let (Some(sp), Some(probe)) = (&points[lane], &probes[lane].emission)
+            {
+                *o = self.env_weight(sp, probe);
+            }
+        }
+        out
+    }
+
     /// An image-space estimator (spatial resampling, say) needs every pixel's shading point
     /// of a pass before it shades any: the renderer then traces the whole pass's camera rays
     /// first and calls [`Self::begin_pass`] with them. Per-point estimators leave this false.
