@@ -168,7 +168,7 @@ mod tests {
         for round in 0..2000 {
             let mut rays = RayPacket::default();
             let mut tmax = [0.0f32; WIDTH];
-            for l in 0..WIDTH {
+            for (l, tmax_l) in tmax.iter_mut().enumerate() {
                 let n = sample_uniform_sphere(rng.next_2d());
                 let o = match (round + l) % 5 {
                     0 => s.center + n * (s.radius + 1e-6),
@@ -188,7 +188,7 @@ mod tests {
                     3.0 * rng.next_1d()
                 };
                 rays.set(l, &Ray::new(o, d, tm));
-                tmax[l] = tm;
+                *tmax_l = tm;
             }
             for isa in Isa::available() {
                 let (mask, t) = crate::simd::run(isa, Lanes16(&s, &rays, tmax));

@@ -19,8 +19,8 @@ impl<const N: usize> PD<N> {
     #[inline(always)]
     fn map2(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
         let mut r = [0.0; N];
-        for i in 0..N {
-            r[i] = f(self.0[i], o.0[i]);
+        for (i, r) in r.iter_mut().enumerate() {
+            *r = f(self.0[i], o.0[i]);
         }
         PD(r)
     }
@@ -54,8 +54,8 @@ impl<const N: usize> Vector64<N> for PD<N> {
     }
     #[inline(always)]
     fn to_f32(self, a: &mut [f32; N]) {
-        for i in 0..N {
-            a[i] = self.0[i] as f32;
+        for (a, x) in a.iter_mut().zip(self.0) {
+            *a = x as f32;
         }
     }
     #[inline(always)]
