@@ -19,8 +19,10 @@ impl<const N: usize> PD<N> {
     #[inline(always)]
     fn map2(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
         let mut r = [0.0; N];
-        for (i, r) in r.iter_mut().enumerate() {
-            *r = f(self.0[i], o.0[i]);
+        // Indexed, as measured: an iterator rewrite was not faster (sphere_light, 6 rounds).
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..N {
+            r[i] = f(self.0[i], o.0[i]);
         }
         PD(r)
     }
@@ -54,8 +56,9 @@ impl<const N: usize> Vector64<N> for PD<N> {
     }
     #[inline(always)]
     fn to_f32(self, a: &mut [f32; N]) {
-        for (a, x) in a.iter_mut().zip(self.0) {
-            *a = x as f32;
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..N {
+            a[i] = self.0[i] as f32;
         }
     }
     #[inline(always)]
