@@ -358,6 +358,27 @@ mod tests {
         ]
     }
 
+    /// Round `round`'s sixteen directions (every third round the special ones) and lane mask
+    /// (every other round all lanes, else a random subset).
+    fn directions(rng: &mut SampleStream, round: usize) -> (Soa3, u32) {
+        let special = special();
+        let mut w = Soa3::default();
+        for lane in 0..WIDTH {
+            let d = if round.is_multiple_of(3) {
+                special[(lane + round) % special.len()]
+            } else {
+                crate::sampling::warp::sample_uniform_sphere(rng.next_2d())
+            };
+            w.set(lane, d);
+        }
+        let mask = if round.is_multiple_of(2) {
+            u32::MAX >> (32 - WIDTH)
+        } else {
+            (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
+        };
+        (w, mask)
+    }
+
     /// Sixteen pdfs at once are the scalar ones, bit for bit, on every ISA and for every
     /// representation (poles, axes, the seam, black texels among them), 0 outside the mask.
     #[test]
@@ -372,20 +393,7 @@ mod tests {
             }
             let m = ImportanceMap::new(texels);
             for round in 0..300 {
-                let mut w = Soa3::default();
-                for lane in 0..WIDTH {
-                    let d = if round % 3 == 0 {
-                        special()[(lane + round) % special().len()]
-                    } else {
-                        crate::sampling::warp::sample_uniform_sphere(rng.next_2d())
-                    };
-                    w.set(lane, d);
-                }
-                let mask = if round % 2 == 0 {
-                    u32::MAX >> (32 - WIDTH)
-                } else {
-                    (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
-                };
+                let (w, mask) = directions(&mut rng, round);
                 for isa in Isa::available() {
                     let got = m.pdf_lanes(isa, &w, mask);
                     for (lane, g) in got.iter().enumerate() {
@@ -411,25 +419,11 @@ mod tests {
     /// directions, and only the masked lanes added.
     #[test]
     fn lookups_over_lanes_are_the_scalar_ones_on_every_isa() {
-        let special = special();
         let mut rng = SampleStream::new(4, 1, 2, 3);
         for repr in Repr::ALL {
             let m = map(repr);
             for round in 0..300 {
-                let mut w = Soa3::default();
-                for lane in 0..WIDTH {
-                    let d = if round % 3 == 0 {
-                        special[(lane + round) % special.len()]
-                    } else {
-                        crate::sampling::warp::sample_uniform_sphere(rng.next_2d())
-                    };
-                    w.set(lane, d);
-                }
-                let mask = if round % 2 == 0 {
-                    u32::MAX >> (32 - WIDTH)
-                } else {
-                    (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
-                };
+                let (w, mask) = directions(&mut rng, round);
                 for isa in Isa::available() {
                     let mut out = [Vec3::splat(0.25); WIDTH];
                     m.add_lookups(isa, &w, mask, &mut out);
