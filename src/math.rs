@@ -1,6 +1,6 @@
 //! Small numeric helpers shared by geometry, samplers and the renderer.
 
-use crate::simd::{V3, Vector, WIDTH};
+use crate::simd::{V3, Vector, Vector64, WIDTH};
 use glam::Vec3;
 
 /// An orthonormal frame around a unit normal (Duff et al., "Building an Orthonormal Basis,
@@ -81,6 +81,134 @@ pub fn atan2<V: Vector<N>, const N: usize>(y: V, x: V) -> V {
     let r = V::select(ax.lt(ay), V::splat(FRAC_PI_2).sub(r), r);
     let r = V::select(x.lt(zero), V::splat(PI).sub(r), r);
     V::select(y.sign(), r.neg(), r)
+}
+
+/// x rounded to the nearest integer (ties to even) by adding and subtracting 1.5·2⁵²: IEEE
+/// additions only, so every ISA and the scalar path agree. For |x| < 2⁵¹.
+#[inline(always)]
+fn round64<D: Vector64<N>, const N: usize>(x: D) -> D {
+    const SHIFT: f64 = 6_755_399_441_055_744.0;
+    x.add(D::splat(SHIFT)).sub(D::splat(SHIFT))
+}
+
+/// (sin x, cos x) in f64, written once over lanes and used by scalar code as one lane (`f64`),
+/// so the spherical rectangle sampled over lanes and alone gives the same bits on every ISA
+/// and C library. Cody–Waite reduction by π/2 in three parts (fdlibm's `pio2_1`, `pio2_2`,
+/// `pio2_2t`: exact products for |n| < 2²⁰), then fdlibm's minimax kernels on [−π/4, π/4]
+/// (`__kernel_sin`, `__kernel_cos`, Sun Microsystems 1993) and the quadrant's swap and signs.
+/// Within 1 ulp of libm for |x| ≤ 64π (the test; the samplers need [0, 2π]); far beyond, the
+/// reduction's two roundings add about an ulp (2 at x ≈ 3800).
+#[inline(always)]
+pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
+    let c = D::splat;
+    let pio2_1 = f64::from_bits(0x3FF9_21FB_5440_0000);
+    let pio2_2 = f64::from_bits(0x3DD0_B461_1A60_0000);
+    let pio2_2t = f64::from_bits(0x3BA3_198A_2E03_7073);
+    let n = round64(x.mul(c(std::f64::consts::FRAC_2_PI)));
+    let z = x
+        .sub(n.mul(c(pio2_1)))
+        .sub(n.mul(c(pio2_2)))
+        .sub(n.mul(c(pio2_2t)));
+    let zz = z.mul(z);
+    // sin z = z + z³·(S1 + z²·(S2 + … + z²·S6))
+    let ps = c(1.589_690_995_211_550_1e-10)
+        .mul(zz)
+        .add(c(-2.505_076_025_340_686_3e-8))
+        .mul(zz)
+        .add(c(2.755_731_370_707_006_8e-6))
+        .mul(zz)
+        .add(c(-1.984_126_982_985_795e-4))
+        .mul(zz)
+        .add(c(8.333_333_333_322_49e-3))
+        .mul(zz)
+        .add(c(-1.666_666_666_666_663_2e-1));
+    let sin = z.add(z.mul(zz).mul(ps));
+    // cos z = 1 − z²/2 + z⁴·(C1 + z²·(C2 + … + z²·C6))
+    let pc = c(-1.135_964_755_778_819_5e-11)
+        .mul(zz)
+        .add(c(2.087_572_321_298_175e-9))
+        .mul(zz)
+        .add(c(-2.755_731_435_139_066_3e-7))
+        .mul(zz)
+        .add(c(2.480_158_728_947_673e-5))
+        .mul(zz)
+        .add(c(-1.388_888_888_887_411e-3))
+        .mul(zz)
+        .add(c(4.166_666_666_666_660_2e-2));
+    // fdlibm's two forms: 1 − (z²/2 − z²·r) below |z| = 0.3; above, z²/2 = qx + hz with qx its
+    // high half (Dekker), so that 1 − qx is exact and the rounding falls on the small terms.
+    let zr = zz.mul(zz.mul(pc));
+    let h = c(0.5).mul(zz);
+    let near = c(1.0).sub(h.sub(zr));
+    let split = h.mul(c(134_217_729.0));
+    let qx = split.sub(split.sub(h));
+    let far = c(1.0).sub(qx).sub(h.sub(qx).sub(zr));
+    let cos = D::select(zz.lt(c(0.09)), near, far);
+    // The quadrant n mod 4, exactly: n − 4·⌊n/4⌋, with ⌊n/4⌋ = round(n/4 − 3/8) for integer n.
+    let q = n.sub(c(4.0).mul(round64(n.mul(c(0.25)).sub(c(0.375)))));
+    let odd = q.eq(c(1.0)) | q.eq(c(3.0));
+    let (s, co) = (D::select(odd, cos, sin), D::select(odd, sin, cos));
+    let sin_neg = q.eq(c(2.0)) | q.eq(c(3.0));
+    let cos_neg = q.eq(c(1.0)) | q.eq(c(2.0));
+    (
+        D::select(sin_neg, s.neg(), s),
+        D::select(cos_neg, co.neg(), co),
+    )
+}
+
+/// fdlibm's rational R(z) for asin on [0, 1/4]: asin x ≈ x + x·R(x²) for |x| ≤ 1/2.
+#[inline(always)]
+fn asin_r<D: Vector64<N>, const N: usize>(z: D) -> D {
+    let c = D::splat;
+    let p = c(3.479_331_075_960_211_7e-5)
+        .mul(z)
+        .add(c(7.915_349_942_898_145e-4))
+        .mul(z)
+        .add(c(-4.005_553_450_067_941e-2))
+        .mul(z)
+        .add(c(2.012_125_321_348_629_3e-1))
+        .mul(z)
+        .add(c(-3.255_658_186_224_009e-1))
+        .mul(z)
+        .add(c(1.666_666_666_666_666_6e-1))
+        .mul(z);
+    let q = c(7.703_815_055_590_193_5e-2)
+        .mul(z)
+        .add(c(-6.882_839_716_054_533e-1))
+        .mul(z)
+        .add(c(2.020_945_760_233_505_7))
+        .mul(z)
+        .add(c(-2.403_394_911_734_414))
+        .mul(z)
+        .add(c(1.0));
+    p.div(q)
+}
+
+/// acos x in f64 for x ∈ [−1, 1], written once over lanes (see [`sin_cos64`]). fdlibm's
+/// `e_acos` (Sun Microsystems 1993) without its branches: |x| ≤ 1/2 by π/2 − asin x; beyond,
+/// by 2·asin √((1 − |x|)/2), with √ split in two (Dekker) where x > 0 so that small results
+/// keep their relative accuracy. Within 1 ulp of libm (the test).
+#[inline(always)]
+pub fn acos64<D: Vector64<N>, const N: usize>(x: D) -> D {
+    let c = D::splat;
+    let pio2_hi = std::f64::consts::FRAC_PI_2;
+    let pio2_lo = 6.123_233_995_736_766e-17;
+    let ax = x.abs();
+    let small = ax.le(c(0.5));
+    let z = D::select(small, x.mul(x), c(1.0).sub(ax).mul(c(0.5)));
+    let r = asin_r(z);
+    let near = c(pio2_hi).sub(x.sub(c(pio2_lo).sub(x.mul(r))));
+    let s = z.sqrt();
+    // x < −1/2: π − 2·(s + s·R)
+    let below = c(std::f64::consts::PI).sub(c(2.0).mul(s.add(r.mul(s).sub(c(pio2_lo)))));
+    // x > 1/2: 2·(df + (s·R + (z − df²)/(s + df))), df the high half of s (exact square).
+    let split = s.mul(c(134_217_729.0));
+    let df = split.sub(split.sub(s));
+    let zero = s.eq(c(0.0));
+    let tail = z.sub(df.mul(df)).div(D::select(zero, c(1.0), s.add(df)));
+    let above = c(2.0).mul(df.add(r.mul(s).add(tail)));
+    let far = D::select(x.sign(), below, above);
+    D::select(small, near, far)
 }
 
 /// γₙ = nε/(1 − nε) with ε = 2⁻²⁴: a bound on the relative error of n chained f32 operations
@@ -190,6 +318,120 @@ pub(crate) mod tests {
             }
         }
         worst
+    }
+
+    /// The worst error of `f` in ulps of f64, against the C library's `want`, at `xs`.
+    fn worst_ulps(
+        xs: impl Iterator<Item = f64>,
+        f: impl Fn(f64) -> f64,
+        want: impl Fn(f64) -> f64,
+    ) -> (f64, f64) {
+        let mut worst = (0.0f64, 0.0);
+        for x in xs {
+            let (got, want) = (f(x), want(x));
+            let w = want.abs();
+            let spacing = f64::from_bits(w.to_bits() + 1) - w;
+            let e = if got == want {
+                0.0
+            } else {
+                (got - want).abs() / spacing
+            };
+            assert!(e.is_finite(), "f({x}) = {got}, want {want}");
+            if e > worst.0 {
+                worst = (e, x);
+            }
+        }
+        worst
+    }
+
+    /// Arguments of acos: a dense sweep of [−1, 1], the ends and their last 2¹⁶ f64s, and the
+    /// branch points ±1/2 with their neighbours.
+    fn acos_args() -> impl Iterator<Item = f64> {
+        let n = 1 << 20;
+        let sweep = (0..=n).map(move |i| -1.0 + 2.0 * i as f64 / n as f64);
+        let ends = (0..1u64 << 16).flat_map(|k| {
+            let one = 1.0f64.to_bits();
+            [f64::from_bits(one - k), -f64::from_bits(one - k)]
+        });
+        let halves = (0..1u64 << 10).flat_map(|k| {
+            let h = 0.5f64.to_bits();
+            [h - k, h + k]
+                .map(f64::from_bits)
+                .into_iter()
+                .flat_map(|x| [x, -x])
+        });
+        sweep.chain(ends).chain(halves)
+    }
+
+    /// Arguments of sin and cos: a dense sweep of [−4π, 4π], each multiple of π/4 up to 64π
+    /// and the 64 f64s either side of it (where sin or cos is near 0), and a sweep up to 64π.
+    fn sin_cos_args() -> impl Iterator<Item = f64> {
+        use std::f64::consts::{FRAC_PI_4, PI};
+        let n = 1 << 20;
+        let sweep = (0..=n).map(move |i| -4.0 * PI + 8.0 * PI * i as f64 / n as f64);
+        let quadrants = (-256..=256i32).flat_map(|k| {
+            let b = (k as f64 * FRAC_PI_4).to_bits();
+            (0..64u64).flat_map(move |j| [f64::from_bits(b + j), f64::from_bits(b - j)])
+        });
+        let far = (0..=n).map(move |i| 64.0 * PI * i as f64 / n as f64);
+        sweep.chain(quadrants).chain(far).filter(|x| x.is_finite())
+    }
+
+    /// acos, sin and cos over lanes are within 1 ulp of the C library's (0.5–1 measured) and
+    /// agree with their one-lane (scalar) form bit for bit; errors of 2 ulps (one control)
+    /// or a lost quadrant sign (the other) are caught.
+    #[test]
+    fn f64_trigonometry_is_accurate_and_the_same_over_lanes() {
+        let acos1 = |x: f64| acos64::<f64, 1>(x);
+        let (worst, at) = worst_ulps(acos_args(), acos1, f64::acos);
+        assert!(worst <= 1.0, "acos: {worst} ulps at {at}");
+        let sin1 = |x: f64| sin_cos64::<f64, 1>(x).0;
+        let cos1 = |x: f64| sin_cos64::<f64, 1>(x).1;
+        let (ws, at_s) = worst_ulps(sin_cos_args(), sin1, f64::sin);
+        let (wc, at_c) = worst_ulps(sin_cos_args(), cos1, f64::cos);
+        assert!(ws <= 1.0, "sin: {ws} ulps at {at_s}");
+        assert!(wc <= 1.0, "cos: {wc} ulps at {at_c}");
+        eprintln!("acos {worst} ulps at {at}, sin {ws} at {at_s}, cos {wc} at {at_c}");
+        // Controls: two ulps off, and cos without its sign in the second and third quadrants.
+        let off = |x: f64| acos1(x) * (1.0 + 4.0 * f64::EPSILON);
+        assert!(worst_ulps(acos_args(), off, f64::acos).0 > 1.0);
+        let unsigned = |x: f64| cos1(x).abs();
+        assert!(worst_ulps(sin_cos_args(), unsigned, f64::cos).0 > 1.0);
+        // Over lanes, on every ISA: the scalar bits.
+        struct Lanes16<'a>(&'a [f64; WIDTH]);
+        impl crate::simd::Kernel for Lanes16<'_> {
+            type Out = ([f64; WIDTH], [f64; WIDTH], [f64; WIDTH]);
+            #[inline(always)]
+            fn run<L: crate::simd::Lanes>(self) -> Self::Out {
+                let x = L::D::from_f64(self.0);
+                let (s, c) = sin_cos64(x);
+                let a = acos64(x.max(L::D::splat(-1.0)).min(L::D::splat(1.0)));
+                (lanes64(s), lanes64(c), lanes64(a))
+            }
+        }
+        let xs: Vec<f64> = acos_args().chain(sin_cos_args()).step_by(7).collect();
+        for isa in crate::simd::Isa::available() {
+            for chunk in xs.chunks_exact(WIDTH) {
+                let x: [f64; WIDTH] = chunk.try_into().unwrap();
+                let (s, c, a) = crate::simd::run(isa, Lanes16(&x));
+                for lane in 0..WIDTH {
+                    let (s1, c1) = sin_cos64::<f64, 1>(x[lane]);
+                    let a1 = acos64::<f64, 1>(x[lane].clamp(-1.0, 1.0));
+                    assert_eq!(
+                        [s[lane], c[lane], a[lane]].map(f64::to_bits),
+                        [s1, c1, a1].map(f64::to_bits),
+                        "{isa:?} at {}",
+                        x[lane]
+                    );
+                }
+            }
+        }
+    }
+
+    fn lanes64<D: Vector64<WIDTH>>(v: D) -> [f64; WIDTH] {
+        let mut a = [0.0; WIDTH];
+        v.to_f64(&mut a);
+        a
     }
 
     /// atan2 is within 3.5 ulps of f64 everywhere (3.16 measured), exact on the axes and at the

@@ -27,7 +27,7 @@ crate::plugin::registry! {
 use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
-use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
+use crate::simd::{Isa, Soa3, V3, Vector, Vector64, WIDTH};
 use bounds::Bounds;
 use glam::Vec3;
 use selector::{LightSelector, SELECTORS, SelectorType};
@@ -356,6 +356,23 @@ impl LaneSamples {
 #[inline(always)]
 pub(crate) fn keep<V: Vector<WIDTH>>(m: u32, new: V3<V>, old: &mut Soa3) {
     V3::select(m, new, V3::load(old)).store(old)
+}
+
+/// f64 lanes rounded to f32 lanes. A function, not a closure: a closure is not always inlined
+/// into the ISA's entry, and outside it its vector operations are calls.
+#[inline(always)]
+pub(crate) fn f32s<V: Vector<WIDTH>, D: Vector64<WIDTH>>(x: D) -> V {
+    let mut a = [0.0f32; WIDTH];
+    x.to_f32(&mut a);
+    V::load(&a)
+}
+
+/// f32 lanes, exactly as f64 lanes.
+#[inline(always)]
+pub(crate) fn d64<V: Vector<WIDTH>, D: Vector64<WIDTH>>(x: V) -> D {
+    let mut a = [0.0f32; WIDTH];
+    x.store(&mut a);
+    D::from_f32(&a)
 }
 
 /// How many f32 a light's [`LaneKernel`] record holds.
@@ -714,4 +731,65 @@ pub fn selection_number(hi: f32, lo: f32) -> f64 {
     // floor by truncation (sample numbers are non-negative, below 2^24 on the grid): one
     // conversion instead of a call to libm's floor without SSE4.1.
     (hi as f64 * GRID) as i64 as f64 / GRID + lo as f64 / GRID
+}
+
+/// What the lights' lane tests share: a light's samples over lanes against its scalar ones.
+#[cfg(test)]
+pub(crate) mod lane_tests {
+    use super::*;
+
+    fn bits(s: Option<LightSample>) -> Option<([u32; 16], bool)> {
+        s.map(|s| {
+            let mut b = [0u32; 16];
+            for (k, v) in [s.wi, s.point, s.normal, s.point_error, s.radiance]
+                .iter()
+                .flat_map(|v| v.to_array())
+                .chain([s.pdf])
+                .enumerate()
+            {
+                b[k] = v.to_bits();
+            }
+            (b, s.distant)
+        })
+    }
+
+    /// `light.sample_lanes` of lanes `active` equals `light.sample` lane by lane, bit for bit,
+    /// on every ISA, and lanes outside `active` keep what they held.
+    pub(crate) fn assert_lanes_are_the_scalar_samples<T: Light>(
+        light: &T,
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        label: &str,
+    ) {
+        let marker = LightSample {
+            wi: Vec3::X,
+            point: Vec3::Y,
+            normal: Vec3::Z,
+            point_error: Vec3::ONE,
+            radiance: Vec3::splat(7.0),
+            pdf: 3.0,
+            distant: true,
+        };
+        for isa in Isa::available() {
+            let mut out = LaneSamples::default();
+            for lane in 0..WIDTH {
+                out.set(lane, Some(marker));
+            }
+            light.sample_lanes(isa, q, active, m, &mut out);
+            for lane in 0..WIDTH {
+                let want = if active >> lane & 1 != 0 {
+                    light.sample(&q.ctx(lane), [q.u[0][lane], q.u[1][lane], q.u[2][lane]], m)
+                } else {
+                    Some(marker)
+                };
+                assert_eq!(
+                    bits(out.get(lane)),
+                    bits(want),
+                    "{isa:?} {label} lane {lane} p {:?}",
+                    q.p.get(lane)
+                );
+            }
+        }
+    }
 }

@@ -7,7 +7,7 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
-    SphereMethod, direction_to, keep, sample_lane_by_lane,
+    SphereMethod, d64, direction_to, f32s, keep, sample_lane_by_lane,
 };
 use crate::math::{Frame, gamma, luminance};
 use crate::sampling::warp::{
@@ -360,23 +360,6 @@ impl SphereLight {
     }
 }
 
-/// f64 lanes rounded to f32 lanes. A function, not a closure: a closure is not always inlined
-/// into the ISA's entry, and outside it its vector operations are calls.
-#[inline(always)]
-fn f32s<V: Vector<WIDTH>, D: Vector64<WIDTH>>(x: D) -> V {
-    let mut a = [0.0f32; WIDTH];
-    x.to_f32(&mut a);
-    V::load(&a)
-}
-
-/// f32 lanes, exactly as f64 lanes.
-#[inline(always)]
-fn d64<V: Vector<WIDTH>, D: Vector64<WIDTH>>(x: V) -> D {
-    let mut a = [0.0f32; WIDTH];
-    x.store(&mut a);
-    D::from_f32(&a)
-}
-
 impl Light for SphereLight {
     fn shape(&self) -> LightShape {
         LightShape::Sphere
@@ -591,24 +574,9 @@ fn chi2_case(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lights::{Light, LightMethods};
+    use crate::lights::LightMethods;
     use crate::sampling::stream::ONE_MINUS_EPSILON;
     use crate::sampling::stream::SampleStream;
-
-    fn bits(s: Option<LightSample>) -> Option<[u32; 16]> {
-        s.map(|s| {
-            let mut b = [0u32; 16];
-            for (k, v) in [s.wi, s.point, s.normal, s.point_error, s.radiance]
-                .iter()
-                .flat_map(|v| v.to_array())
-                .chain([s.pdf])
-                .enumerate()
-            {
-                b[k] = v.to_bits();
-            }
-            b
-        })
-    }
 
     /// Cone samples of sixteen lanes at once are the scalar ones, bit for bit, on every ISA:
     /// points far away, 1e-6 off the surface, on it and inside (lane by lane there), with u at
@@ -651,36 +619,10 @@ mod tests {
             } else {
                 (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
             };
-            for isa in Isa::available() {
-                let mut out = LaneSamples::default();
-                let marker = LightSample {
-                    wi: Vec3::X,
-                    point: Vec3::Y,
-                    normal: Vec3::Z,
-                    point_error: Vec3::ONE,
-                    radiance: Vec3::splat(7.0),
-                    pdf: 3.0,
-                    distant: true,
-                };
-                for lane in 0..WIDTH {
-                    out.set(lane, Some(marker));
-                }
-                light.sample_lanes(isa, &q, active, &m, &mut out);
-                for lane in 0..WIDTH {
-                    let want = if active >> lane & 1 != 0 {
-                        light.sample(&q.ctx(lane), [q.u[0][lane], q.u[1][lane], q.u[2][lane]], &m)
-                    } else {
-                        Some(marker)
-                    };
-                    let got = out.get(lane);
-                    assert_eq!(
-                        (bits(got), got.map(|s| s.distant)),
-                        (bits(want), want.map(|s| s.distant)),
-                        "{isa:?} round {round} lane {lane} p {:?}",
-                        q.p.get(lane)
-                    );
-                }
-            }
+            let label = format!("round {round}");
+            crate::lights::lane_tests::assert_lanes_are_the_scalar_samples(
+                &light, &q, active, &m, &label,
+            );
         }
     }
 }

@@ -4,6 +4,8 @@
 //! #340). Below [`MIN_SOLID_ANGLE`] callers fall back to area sampling, with the same decision
 //! in sampler and pdf.
 
+use crate::math::{acos64, sin_cos64};
+use crate::simd::Vector64;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -91,54 +93,127 @@ impl SphericalTriangle {
     }
 }
 
-/// A rectangle corner + s·ex·len_x + t·ey·len_y seen from the origin (Ureña et al. 2013, §3).
-pub struct SphericalRectangle {
-    x: DVec3,
-    y: DVec3,
-    z: DVec3,
-    x0: f64,
-    x1: f64,
-    y0: f64,
-    y1: f64,
-    z0: f64,
-    b0: f64,
-    b1: f64,
-    k: f64,
-    area: f64,
+/// f64 three-vectors as lanes (`[x, y, z]`), for the rectangle written over lanes.
+pub type D3<D> = [D; 3];
+
+#[inline(always)]
+fn dot<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D {
+    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
 }
 
-impl SphericalRectangle {
+#[inline(always)]
+fn cross<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D3<D> {
+    [
+        a[1].mul(b[2]).sub(b[1].mul(a[2])),
+        a[2].mul(b[0]).sub(b[2].mul(a[0])),
+        a[0].mul(b[1]).sub(b[0].mul(a[1])),
+    ]
+}
+
+// Functions, not closures: a closure is not always inlined into the ISA's entry, and outside
+// it its vector operations are calls.
+#[inline(always)]
+fn scale<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
+    [a[0].mul(s), a[1].mul(s), a[2].mul(s)]
+}
+
+#[inline(always)]
+fn div3<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
+    [a[0].div(s), a[1].div(s), a[2].div(s)]
+}
+
+/// The interior angle at the shared edge of two of the rectangle's planes, by their normals.
+/// The clamp keeps acos in its domain under rounding only.
+#[inline(always)]
+fn angle<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D {
+    acos64(clamp(dot(a, b).neg(), D::splat(-1.0), D::splat(1.0)))
+}
+
+/// `a` times 1/|a|, as glam normalises.
+#[inline(always)]
+fn normalize<D: Vector64<N>, const N: usize>(a: D3<D>) -> D3<D> {
+    scale(a, D::splat(1.0).div(dot(a, a).sqrt()))
+}
+
+/// `x` clamped to [lo, hi] (lo ≤ hi).
+#[inline(always)]
+fn clamp<D: Vector64<N>, const N: usize>(x: D, lo: D, hi: D) -> D {
+    x.max(lo).min(hi)
+}
+
+/// One-lane [`D3`] of a `DVec3`.
+pub fn d3(v: DVec3) -> D3<f64> {
+    v.to_array()
+}
+
+/// A rectangle corner + s·ex·len_x + t·ey·len_y seen from the origin (Ureña et al. 2013, §3),
+/// for the lanes of `D` (`f64`: one rectangle). Written once over lanes, trigonometry included
+/// ([`acos64`], [`sin_cos64`]), so sampled over lanes and alone it gives the same bits.
+#[derive(Clone, Copy)]
+pub struct SphericalRectangle<D = f64> {
+    x: D3<D>,
+    y: D3<D>,
+    z: D3<D>,
+    x0: D,
+    x1: D,
+    y0: D,
+    y1: D,
+    z0: D,
+    b0: D,
+    b1: D,
+    k: D,
+    area: D,
+}
+
+impl SphericalRectangle<f64> {
     /// `corner` relative to the viewpoint; `ex`, `ey` orthogonal edges. None when the viewpoint
     /// lies in the rectangle's plane (zero solid angle).
     pub fn new(corner: DVec3, ex: DVec3, ey: DVec3) -> Option<Self> {
-        let (len_x, len_y) = (ex.length(), ey.length());
-        let (x, y) = (ex / len_x, ey / len_y);
-        let mut z = x.cross(y);
-        let mut z0 = corner.dot(z);
-        if z0 > 0.0 {
-            z = -z;
-            z0 = -z0;
-        }
-        if z0 == 0.0 {
-            return None;
-        }
-        let (x0, y0) = (corner.dot(x), corner.dot(y));
-        let (x1, y1) = (x0 + len_x, y0 + len_y);
-        let v00 = DVec3::new(x0, y0, z0);
-        let v01 = DVec3::new(x0, y1, z0);
-        let v10 = DVec3::new(x1, y0, z0);
-        let v11 = DVec3::new(x1, y1, z0);
-        let n0 = v00.cross(v10).normalize();
-        let n1 = v10.cross(v11).normalize();
-        let n2 = v11.cross(v01).normalize();
-        let n3 = v01.cross(v00).normalize();
-        let g0 = (-n0.dot(n1)).clamp(-1.0, 1.0).acos();
-        let g1 = (-n1.dot(n2)).clamp(-1.0, 1.0).acos();
-        let g2 = (-n2.dot(n3)).clamp(-1.0, 1.0).acos();
-        let g3 = (-n3.dot(n0)).clamp(-1.0, 1.0).acos();
-        let k = 2.0 * PI - g2 - g3;
-        let area = g0 + g1 - k;
-        (area > 0.0).then_some(SphericalRectangle {
+        let (r, valid) = Self::lanes(d3(corner), d3(ex), d3(ey));
+        (valid != 0).then_some(r)
+    }
+
+    /// The point on the rectangle (relative to the viewpoint) for u ∈ [0,1)², uniform in solid
+    /// angle.
+    pub fn sample(&self, u: [f64; 2]) -> DVec3 {
+        DVec3::from_array(self.sample_lanes(u[0], u[1]))
+    }
+}
+
+impl<D: Copy> SphericalRectangle<D> {
+    /// [`SphericalRectangle::new`] over lanes: the rectangles and the lanes that have one (bit
+    /// i: lane i). Lanes without one hold finite values that mean nothing.
+    #[inline(always)]
+    pub fn lanes<const N: usize>(corner: D3<D>, ex: D3<D>, ey: D3<D>) -> (Self, u32)
+    where
+        D: Vector64<N>,
+    {
+        let c = D::splat;
+        let (len_x, len_y) = (dot(ex, ex).sqrt(), dot(ey, ey).sqrt());
+        let (x, y) = (div3(ex, len_x), div3(ey, len_y));
+        let z = cross(x, y);
+        let z0 = dot(corner, z);
+        let flip = c(0.0).lt(z0);
+        let z = scale(z, D::select(flip, c(-1.0), c(1.0)));
+        let z0 = D::select(flip, z0.neg(), z0);
+        let mut valid = !z0.eq(c(0.0));
+        // A lane in the plane takes z0 = −1 instead, so that no normal below is 0/0.
+        let z0 = D::select(valid, z0, c(-1.0));
+        let (x0, y0) = (dot(corner, x), dot(corner, y));
+        let (x1, y1) = (x0.add(len_x), y0.add(len_y));
+        let v00 = [x0, y0, z0];
+        let v01 = [x0, y1, z0];
+        let v10 = [x1, y0, z0];
+        let v11 = [x1, y1, z0];
+        let n0 = normalize(cross(v00, v10));
+        let n1 = normalize(cross(v10, v11));
+        let n2 = normalize(cross(v11, v01));
+        let n3 = normalize(cross(v01, v00));
+        let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
+        let k = c(2.0 * PI).sub(g2).sub(g3);
+        let area = g0.add(g1).sub(k);
+        valid &= c(0.0).lt(area);
+        let r = SphericalRectangle {
             x,
             y,
             z,
@@ -147,37 +222,60 @@ impl SphericalRectangle {
             y0,
             y1,
             z0,
-            b0: n0.z,
-            b1: n2.z,
+            b0: n0[2],
+            b1: n2[2],
             k,
             area,
-        })
+        };
+        (r, valid)
     }
 
-    pub fn area(&self) -> f64 {
+    /// The solid angle the sampler is uniform over.
+    pub fn area(&self) -> D {
         self.area
     }
 
-    /// The point on the rectangle (relative to the viewpoint) for u ∈ [0,1)², uniform in solid
-    /// angle. The clamps keep the inverse trigonometry in its domain under rounding only.
-    pub fn sample(&self, u: [f64; 2]) -> DVec3 {
-        let au = u[0] * self.area + self.k;
-        let fu = (au.cos() * self.b0 - self.b1) / au.sin();
-        let cu = (1.0 / (fu * fu + self.b0 * self.b0).sqrt())
-            .copysign(fu)
-            .clamp(-1.0, 1.0);
-        let xu = (-(cu * self.z0) / (1.0 - cu * cu).max(0.0).sqrt()).clamp(self.x0, self.x1);
-        let d = (xu * xu + self.z0 * self.z0).sqrt();
-        let h0 = self.y0 / (d * d + self.y0 * self.y0).sqrt();
-        let h1 = self.y1 / (d * d + self.y1 * self.y1).sqrt();
-        let hv = h0 + u[1] * (h1 - h0);
-        let hv2 = hv * hv;
-        let yv = if hv2 < 1.0 - 1e-12 {
-            hv * d / (1.0 - hv2).sqrt()
-        } else {
-            self.y1
-        };
-        xu * self.x + yv.clamp(self.y0, self.y1) * self.y + self.z0 * self.z
+    /// [`SphericalRectangle::sample`] over lanes, for u = (u0, u1). The clamps keep the inverse
+    /// trigonometry in its domain under rounding only; where the cosine of the u-edge's angle
+    /// rounds to ±1, its point is the edge's end (the limit), not ±∞ clamped.
+    #[inline(always)]
+    pub fn sample_lanes<const N: usize>(&self, u0: D, u1: D) -> D3<D>
+    where
+        D: Vector64<N>,
+    {
+        let c = D::splat;
+        let (one, zero) = (c(1.0), c(0.0));
+        let au = u0.mul(self.area).add(self.k);
+        let (sin_au, cos_au) = sin_cos64(au);
+        let fu = cos_au.mul(self.b0).sub(self.b1).div(sin_au);
+        let inv = one.div(fu.mul(fu).add(self.b0.mul(self.b0)).sqrt());
+        let cu = clamp(D::select(fu.sign(), inv.neg(), inv), c(-1.0), one);
+        let den = one.sub(cu.mul(cu)).max(zero).sqrt();
+        let edge = den.eq(zero);
+        let xu = clamp(
+            cu.mul(self.z0).neg().div(D::select(edge, one, den)),
+            self.x0,
+            self.x1,
+        );
+        let xu = D::select(edge, D::select(cu.sign(), self.x0, self.x1), xu);
+        let d = xu.mul(xu).add(self.z0.mul(self.z0)).sqrt();
+        let h0 = self.y0.div(d.mul(d).add(self.y0.mul(self.y0)).sqrt());
+        let h1 = self.y1.div(d.mul(d).add(self.y1.mul(self.y1)).sqrt());
+        let hv = h0.add(u1.mul(h1.sub(h0)));
+        let hv2 = hv.mul(hv);
+        let inside = hv2.lt(c(1.0 - 1e-12));
+        let yv = D::select(
+            inside,
+            hv.mul(d).div(D::select(inside, one.sub(hv2), one).sqrt()),
+            self.y1,
+        );
+        let yv = clamp(yv, self.y0, self.y1);
+        let (a, b, e) = (scale(self.x, xu), scale(self.y, yv), scale(self.z, self.z0));
+        [
+            a[0].add(b[0]).add(e[0]),
+            a[1].add(b[1]).add(e[1]),
+            a[2].add(b[2]).add(e[2]),
+        ]
     }
 }
 

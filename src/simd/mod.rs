@@ -71,6 +71,7 @@ pub trait Vector64<const N: usize>: Copy {
     fn from_f32(a: &[f32; N]) -> Self;
     /// Each lane rounded to the nearest f32 (`as f32`).
     fn to_f32(self, a: &mut [f32; N]);
+    fn to_f64(self, a: &mut [f64; N]);
     fn add(self, o: Self) -> Self;
     fn sub(self, o: Self) -> Self;
     fn mul(self, o: Self) -> Self;
@@ -79,6 +80,8 @@ pub trait Vector64<const N: usize>: Copy {
     fn min(self, o: Self) -> Self;
     /// `if a > b { a } else { b }` per lane.
     fn max(self, o: Self) -> Self;
+    /// The sign bit cleared.
+    fn abs(self) -> Self;
     fn sqrt(self) -> Self;
     /// The sign bit flipped.
     fn neg(self) -> Self;

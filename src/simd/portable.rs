@@ -62,6 +62,10 @@ impl<const N: usize> Vector64<N> for PD<N> {
         }
     }
     #[inline(always)]
+    fn to_f64(self, a: &mut [f64; N]) {
+        *a = self.0;
+    }
+    #[inline(always)]
     fn add(self, o: Self) -> Self {
         self.map2(o, |x, y| x + y)
     }
@@ -84,6 +88,14 @@ impl<const N: usize> Vector64<N> for PD<N> {
     #[inline(always)]
     fn max(self, o: Self) -> Self {
         self.map2(o, |x, y| if x > y { x } else { y })
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        let mut r = self.0;
+        for x in &mut r {
+            *x = x.abs();
+        }
+        PD(r)
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -240,6 +252,88 @@ impl<const N: usize> Vector<N> for P<N> {
         P(std::array::from_fn(|i| {
             if m & (1 << i) != 0 { a.0[i] } else { b.0[i] }
         }))
+    }
+}
+
+/// One f64 is a one-lane f64 vector, as [`Vector<1> for f32`](Vector) is for f32: scalar code
+/// runs the f64 kernels written over lanes (the spherical rectangle, its trigonometry).
+impl Vector64<1> for f64 {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn from_f64(a: &[f64; 1]) -> Self {
+        a[0]
+    }
+    #[inline(always)]
+    fn from_f32(a: &[f32; 1]) -> Self {
+        a[0] as f64
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; 1]) {
+        a[0] = self as f32;
+    }
+    #[inline(always)]
+    fn to_f64(self, a: &mut [f64; 1]) {
+        a[0] = self;
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        self - o
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self * o
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        self / o
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        if self < o { self } else { o }
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        if self > o { self } else { o }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::abs(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        -self
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> u32 {
+        (self < o) as u32
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> u32 {
+        (self <= o) as u32
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> u32 {
+        (self == o) as u32
+    }
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        self.is_sign_negative() as u32
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        let keep = 0u64.wrapping_sub((m & 1) as u64);
+        f64::from_bits((a.to_bits() & keep) | (b.to_bits() & !keep))
     }
 }
 
