@@ -111,7 +111,7 @@ pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
         .sub(n.mul(c(pio2_2t)));
     let zz = z.mul(z);
     // sin z = z + z³·(S1 + z²·(S2 + … + z²·S6))
-    let ps = c(1.589_690_995_211_550_1e-10)
+    let ps = c(1.589_690_995_211_55e-10)
         .mul(zz)
         .add(c(-2.505_076_025_340_686_3e-8))
         .mul(zz)
@@ -134,7 +134,7 @@ pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
         .mul(zz)
         .add(c(-1.388_888_888_887_411e-3))
         .mul(zz)
-        .add(c(4.166_666_666_666_660_2e-2));
+        .add(c(4.166_666_666_666_66e-2));
     // fdlibm's two forms: 1 − (z²/2 − z²·r) below |z| = 0.3; above, z²/2 = qx + hz with qx its
     // high half (Dekker), so that 1 − qx is exact and the rounding falls on the small terms.
     let zr = zz.mul(zz.mul(pc));
@@ -160,7 +160,7 @@ pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
 #[inline(always)]
 fn asin_r<D: Vector64<N>, const N: usize>(z: D) -> D {
     let c = D::splat;
-    let p = c(3.479_331_075_960_211_7e-5)
+    let p = c(3.479_331_075_960_212e-5)
         .mul(z)
         .add(c(7.915_349_942_898_145e-4))
         .mul(z)
@@ -172,7 +172,7 @@ fn asin_r<D: Vector64<N>, const N: usize>(z: D) -> D {
         .mul(z)
         .add(c(1.666_666_666_666_666_6e-1))
         .mul(z);
-    let q = c(7.703_815_055_590_193_5e-2)
+    let q = c(7.703_815_055_590_194e-2)
         .mul(z)
         .add(c(-6.882_839_716_054_533e-1))
         .mul(z)

@@ -2,7 +2,7 @@
 //! deliberately not enabled, so the path rounds exactly like the others.
 #![cfg(target_arch = "x86_64")]
 
-use super::{Kernel, Lanes, NARROW, Vector, WIDTH};
+use super::{Kernel, Lanes, NARROW, Vector, Vector64, WIDTH};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy)]
@@ -18,7 +18,7 @@ pub unsafe fn entry<K: Kernel>(k: K) -> K::Out {
 impl Lanes for Avx2 {
     type V = Y2;
     type W = Y;
-    type D = super::portable::PD<WIDTH>;
+    type D = YD;
 }
 
 /// 8 lanes in one ymm register; also the AVX-512 path's narrow vector. Only ever used inside
@@ -225,5 +225,160 @@ impl Vector<WIDTH> for Y2 {
     #[inline(always)]
     fn reduce_max(self) -> f32 {
         self.0.max(self.1).reduce_max()
+    }
+}
+
+/// 16 f64 lanes in four ymm registers (lanes 0–3, 4–7, 8–11, 12–15). Only ever used inside an
+/// `avx2` entry.
+#[derive(Clone, Copy)]
+pub struct YD([__m256d; 4]);
+
+/// Expands 4 mask bits into all-ones / all-zeros f64 lanes.
+#[inline(always)]
+fn expand64(m: u32) -> __m256d {
+    unsafe {
+        let bit = _mm256_setr_epi64x(1, 2, 4, 8);
+        let v = _mm256_and_si256(_mm256_set1_epi64x(m as i64), bit);
+        _mm256_castsi256_pd(_mm256_cmpeq_epi64(v, bit))
+    }
+}
+
+macro_rules! op64 {
+    ($name:ident, $f:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            let (a, b) = (self.0, o.0);
+            unsafe {
+                YD([
+                    $f(a[0], b[0]),
+                    $f(a[1], b[1]),
+                    $f(a[2], b[2]),
+                    $f(a[3], b[3]),
+                ])
+            }
+        }
+    };
+}
+
+macro_rules! cmp64 {
+    ($name:ident, $p:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> u32 {
+            let (a, b) = (self.0, o.0);
+            unsafe {
+                _mm256_movemask_pd(_mm256_cmp_pd::<$p>(a[0], b[0])) as u32
+                    | (_mm256_movemask_pd(_mm256_cmp_pd::<$p>(a[1], b[1])) as u32) << 4
+                    | (_mm256_movemask_pd(_mm256_cmp_pd::<$p>(a[2], b[2])) as u32) << 8
+                    | (_mm256_movemask_pd(_mm256_cmp_pd::<$p>(a[3], b[3])) as u32) << 12
+            }
+        }
+    };
+}
+
+impl YD {
+    op64!(andnot, _mm256_andnot_pd);
+    op64!(xor, _mm256_xor_pd);
+}
+
+impl Vector64<WIDTH> for YD {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        unsafe { YD([_mm256_set1_pd(x); 4]) }
+    }
+    #[inline(always)]
+    fn from_f64(a: &[f64; WIDTH]) -> Self {
+        let p = a.as_ptr();
+        unsafe {
+            YD([
+                _mm256_loadu_pd(p),
+                _mm256_loadu_pd(p.add(4)),
+                _mm256_loadu_pd(p.add(8)),
+                _mm256_loadu_pd(p.add(12)),
+            ])
+        }
+    }
+    #[inline(always)]
+    fn from_f32(a: &[f32; WIDTH]) -> Self {
+        let p = a.as_ptr();
+        unsafe {
+            YD([
+                _mm256_cvtps_pd(_mm_loadu_ps(p)),
+                _mm256_cvtps_pd(_mm_loadu_ps(p.add(4))),
+                _mm256_cvtps_pd(_mm_loadu_ps(p.add(8))),
+                _mm256_cvtps_pd(_mm_loadu_ps(p.add(12))),
+            ])
+        }
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; WIDTH]) {
+        // Rounded to nearest, as `as f32`.
+        let p = a.as_mut_ptr();
+        unsafe {
+            _mm_storeu_ps(p, _mm256_cvtpd_ps(self.0[0]));
+            _mm_storeu_ps(p.add(4), _mm256_cvtpd_ps(self.0[1]));
+            _mm_storeu_ps(p.add(8), _mm256_cvtpd_ps(self.0[2]));
+            _mm_storeu_ps(p.add(12), _mm256_cvtpd_ps(self.0[3]));
+        }
+    }
+    #[inline(always)]
+    fn to_f64(self, a: &mut [f64; WIDTH]) {
+        let p = a.as_mut_ptr();
+        unsafe {
+            _mm256_storeu_pd(p, self.0[0]);
+            _mm256_storeu_pd(p.add(4), self.0[1]);
+            _mm256_storeu_pd(p.add(8), self.0[2]);
+            _mm256_storeu_pd(p.add(12), self.0[3]);
+        }
+    }
+    op64!(add, _mm256_add_pd);
+    op64!(sub, _mm256_sub_pd);
+    op64!(mul, _mm256_mul_pd);
+    op64!(div, _mm256_div_pd);
+    op64!(min, _mm256_min_pd);
+    op64!(max, _mm256_max_pd);
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Self::splat(-0.0).andnot(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let a = self.0;
+        unsafe {
+            YD([
+                _mm256_sqrt_pd(a[0]),
+                _mm256_sqrt_pd(a[1]),
+                _mm256_sqrt_pd(a[2]),
+                _mm256_sqrt_pd(a[3]),
+            ])
+        }
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Self::splat(-0.0).xor(self)
+    }
+    cmp64!(lt, _CMP_LT_OQ);
+    cmp64!(le, _CMP_LE_OQ);
+    cmp64!(eq, _CMP_EQ_OQ);
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        let a = self.0;
+        unsafe {
+            _mm256_movemask_pd(a[0]) as u32
+                | (_mm256_movemask_pd(a[1]) as u32) << 4
+                | (_mm256_movemask_pd(a[2]) as u32) << 8
+                | (_mm256_movemask_pd(a[3]) as u32) << 12
+        }
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        let (a, b) = (a.0, b.0);
+        unsafe {
+            YD([
+                _mm256_blendv_pd(b[0], a[0], expand64(m)),
+                _mm256_blendv_pd(b[1], a[1], expand64(m >> 4)),
+                _mm256_blendv_pd(b[2], a[2], expand64(m >> 8)),
+                _mm256_blendv_pd(b[3], a[3], expand64(m >> 12)),
+            ])
+        }
     }
 }

@@ -3,7 +3,7 @@
 #![cfg(target_arch = "x86_64")]
 
 use super::avx2::Y;
-use super::{Kernel, Lanes, Vector, WIDTH};
+use super::{Kernel, Lanes, Vector, Vector64, WIDTH};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy)]
@@ -22,7 +22,7 @@ pub unsafe fn entry<K: Kernel>(k: K) -> K::Out {
 impl Lanes for Avx512 {
     type V = Z;
     type W = Y;
-    type D = super::portable::PD<WIDTH>;
+    type D = ZD;
 }
 
 #[derive(Clone, Copy)]
@@ -134,4 +134,127 @@ impl Vector<WIDTH> for Z {
 #[inline(always)]
 fn sign_bits(v: __m512) -> u32 {
     unsafe { _mm512_cmplt_epi32_mask(_mm512_castps_si512(v), _mm512_setzero_si512()) as u32 }
+}
+
+/// 16 f64 lanes in two zmm registers (lanes 0–7, 8–15); k-masks of 8 bits each.
+#[derive(Clone, Copy)]
+pub struct ZD(__m512d, __m512d);
+
+macro_rules! op64 {
+    ($name:ident, $f:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            unsafe { ZD($f(self.0, o.0), $f(self.1, o.1)) }
+        }
+    };
+}
+
+macro_rules! cmp64 {
+    ($name:ident, $p:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> u32 {
+            unsafe {
+                _mm512_cmp_pd_mask::<$p>(self.0, o.0) as u32
+                    | (_mm512_cmp_pd_mask::<$p>(self.1, o.1) as u32) << 8
+            }
+        }
+    };
+}
+
+/// The sign bit of every lane as a 64-bit integer.
+#[inline(always)]
+fn sign64() -> __m512i {
+    unsafe { _mm512_set1_epi64(i64::MIN) }
+}
+
+/// |x| and −x: avx512f has no and/xor for pd (that is avx512dq), so as integers. Functions,
+/// not closures: a closure is not always inlined into the ISA's entry.
+#[inline(always)]
+fn abs_pd(x: __m512d) -> __m512d {
+    unsafe { _mm512_castsi512_pd(_mm512_andnot_si512(sign64(), _mm512_castpd_si512(x))) }
+}
+
+#[inline(always)]
+fn neg_pd(x: __m512d) -> __m512d {
+    unsafe { _mm512_castsi512_pd(_mm512_xor_si512(sign64(), _mm512_castpd_si512(x))) }
+}
+
+#[inline(always)]
+fn sign_pd(x: __m512d) -> u32 {
+    unsafe { _mm512_test_epi64_mask(_mm512_castpd_si512(x), sign64()) as u32 }
+}
+
+impl Vector64<WIDTH> for ZD {
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        unsafe { ZD(_mm512_set1_pd(x), _mm512_set1_pd(x)) }
+    }
+    #[inline(always)]
+    fn from_f64(a: &[f64; WIDTH]) -> Self {
+        unsafe {
+            ZD(
+                _mm512_loadu_pd(a.as_ptr()),
+                _mm512_loadu_pd(a.as_ptr().add(8)),
+            )
+        }
+    }
+    #[inline(always)]
+    fn from_f32(a: &[f32; WIDTH]) -> Self {
+        unsafe {
+            ZD(
+                _mm512_cvtps_pd(_mm256_loadu_ps(a.as_ptr())),
+                _mm512_cvtps_pd(_mm256_loadu_ps(a.as_ptr().add(8))),
+            )
+        }
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; WIDTH]) {
+        // Rounded to nearest, as `as f32`.
+        unsafe {
+            _mm256_storeu_ps(a.as_mut_ptr(), _mm512_cvtpd_ps(self.0));
+            _mm256_storeu_ps(a.as_mut_ptr().add(8), _mm512_cvtpd_ps(self.1));
+        }
+    }
+    #[inline(always)]
+    fn to_f64(self, a: &mut [f64; WIDTH]) {
+        unsafe {
+            _mm512_storeu_pd(a.as_mut_ptr(), self.0);
+            _mm512_storeu_pd(a.as_mut_ptr().add(8), self.1);
+        }
+    }
+    op64!(add, _mm512_add_pd);
+    op64!(sub, _mm512_sub_pd);
+    op64!(mul, _mm512_mul_pd);
+    op64!(div, _mm512_div_pd);
+    op64!(min, _mm512_min_pd);
+    op64!(max, _mm512_max_pd);
+    #[inline(always)]
+    fn abs(self) -> Self {
+        ZD(abs_pd(self.0), abs_pd(self.1))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        unsafe { ZD(_mm512_sqrt_pd(self.0), _mm512_sqrt_pd(self.1)) }
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        ZD(neg_pd(self.0), neg_pd(self.1))
+    }
+    cmp64!(lt, _CMP_LT_OQ);
+    cmp64!(le, _CMP_LE_OQ);
+    cmp64!(eq, _CMP_EQ_OQ);
+    #[inline(always)]
+    fn sign(self) -> u32 {
+        sign_pd(self.0) | sign_pd(self.1) << 8
+    }
+    #[inline(always)]
+    fn select(m: u32, a: Self, b: Self) -> Self {
+        // mask_blend takes the second operand where the bit is set.
+        unsafe {
+            ZD(
+                _mm512_mask_blend_pd(m as __mmask8, b.0, a.0),
+                _mm512_mask_blend_pd((m >> 8) as __mmask8, b.1, a.1),
+            )
+        }
+    }
 }
