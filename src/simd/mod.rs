@@ -1,6 +1,7 @@
 //! The lane layer: f32 vectors of 16 lanes (a ray packet: 1×16 on AVX-512, 2×8 on AVX2) and of
 //! 8 lanes (one single ray against the 8 children of a wide node or an 8-triangle leaf block:
-//! one ymm register on both AVX2 and AVX-512), and plain arrays elsewhere. This module is the
+//! one ymm register on both AVX2 and AVX-512), f64 vectors of 16 lanes for the sample-path code
+//! whose numerics need f64, and plain arrays elsewhere. This module is the
 //! only place that touches `std::arch`; kernels are written once, generic over [`Lanes`], and
 //! monomorphised inside one `#[target_feature]` entry per ISA ([`run`]), so every intrinsic
 //! inlines into the whole kernel (no intrinsic is left as an out-of-line call).
@@ -100,9 +101,9 @@ pub trait Lanes: Copy {
     type V: Vector<WIDTH>;
     /// 8 lanes: a wide node's children or a leaf block's triangles.
     type W: Vector<NARROW>;
-    /// 16 f64 lanes. Every ISA uses the portable arrays: inside the ISA's `#[target_feature]`
-    /// entry the compiler turns their lane loops into that ISA's packed f64 instructions
-    /// (checked in the disassembly: `vaddpd`/`vdivpd`/`vsqrtpd` on ymm or zmm registers).
+    /// 16 f64 lanes: two zmm registers on AVX-512, four ymm on AVX2, an array on the portable
+    /// path. (Portable arrays on every ISA vectorised only in part in a kernel as large as the
+    /// spherical rectangle's, with scalar `sd` instructions and spills: docs/tracer.md.)
     type D: Vector64<WIDTH>;
 }
 

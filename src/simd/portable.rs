@@ -11,7 +11,7 @@ impl Lanes for Portable {
     type D = PD<WIDTH>;
 }
 
-/// f64 lanes as a plain array: every ISA's [`Lanes::D`] (see there).
+/// f64 lanes as a plain array: the portable path's [`Lanes::D`] (see there).
 #[derive(Clone, Copy)]
 pub struct PD<const N: usize>([f64; N]);
 
