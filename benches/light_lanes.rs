@@ -17,11 +17,7 @@ fn packets() -> Vec<LaneQuery> {
     let mut rng = SampleStream::new(1, 2, 3, 4);
     (0..64)
         .map(|_| {
-            let mut q = LaneQuery {
-                p: Default::default(),
-                n: Default::default(),
-                u: [[0.0; WIDTH]; 3],
-            };
+            let mut q = LaneQuery::default();
             for lane in 0..WIDTH {
                 let [a, b] = rng.next_2d();
                 q.p.set(lane, Vec3::new(4.0 * a - 2.0, 0.0, 4.0 * b - 2.0));

@@ -91,6 +91,17 @@ fn round64<D: Vector64<N>, const N: usize>(x: D) -> D {
     x.add(D::splat(SHIFT)).sub(D::splat(SHIFT))
 }
 
+/// The polynomial with coefficients `k`, highest power first, at `z` by Horner's rule:
+/// (k₀·z + k₁)·z + … + kₙ, one product and one sum per step.
+#[inline(always)]
+fn horner<D: Vector64<N>, const N: usize, const K: usize>(z: D, k: [f64; K]) -> D {
+    let mut acc = D::splat(k[0]);
+    for &c in &k[1..] {
+        acc = acc.mul(z).add(D::splat(c));
+    }
+    acc
+}
+
 /// (sin x, cos x) in f64, written once over lanes and used by scalar code as one lane (`f64`),
 /// so the spherical rectangle sampled over lanes and alone gives the same bits on every ISA
 /// and C library. Cody–Waite reduction by π/2 in three parts (fdlibm's `pio2_1`, `pio2_2`,
@@ -111,30 +122,30 @@ pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
         .sub(n.mul(c(pio2_2t)));
     let zz = z.mul(z);
     // sin z = z + z³·(S1 + z²·(S2 + … + z²·S6))
-    let ps = c(1.589_690_995_211_55e-10)
-        .mul(zz)
-        .add(c(-2.505_076_025_340_686_3e-8))
-        .mul(zz)
-        .add(c(2.755_731_370_707_006_8e-6))
-        .mul(zz)
-        .add(c(-1.984_126_982_985_795e-4))
-        .mul(zz)
-        .add(c(8.333_333_333_322_49e-3))
-        .mul(zz)
-        .add(c(-1.666_666_666_666_663_2e-1));
+    let ps = horner(
+        zz,
+        [
+            1.589_690_995_211_55e-10,
+            -2.505_076_025_340_686_3e-8,
+            2.755_731_370_707_006_8e-6,
+            -1.984_126_982_985_795e-4,
+            8.333_333_333_322_49e-3,
+            -1.666_666_666_666_663_2e-1,
+        ],
+    );
     let sin = z.add(z.mul(zz).mul(ps));
     // cos z = 1 − z²/2 + z⁴·(C1 + z²·(C2 + … + z²·C6))
-    let pc = c(-1.135_964_755_778_819_5e-11)
-        .mul(zz)
-        .add(c(2.087_572_321_298_175e-9))
-        .mul(zz)
-        .add(c(-2.755_731_435_139_066_3e-7))
-        .mul(zz)
-        .add(c(2.480_158_728_947_673e-5))
-        .mul(zz)
-        .add(c(-1.388_888_888_887_411e-3))
-        .mul(zz)
-        .add(c(4.166_666_666_666_66e-2));
+    let pc = horner(
+        zz,
+        [
+            -1.135_964_755_778_819_5e-11,
+            2.087_572_321_298_175e-9,
+            -2.755_731_435_139_066_3e-7,
+            2.480_158_728_947_673e-5,
+            -1.388_888_888_887_411e-3,
+            4.166_666_666_666_66e-2,
+        ],
+    );
     // fdlibm's two forms: 1 − (z²/2 − z²·r) below |z| = 0.3; above, z²/2 = qx + hz with qx its
     // high half (Dekker), so that 1 − qx is exact and the rounding falls on the small terms.
     let zr = zz.mul(zz.mul(pc));
@@ -159,28 +170,28 @@ pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
 /// fdlibm's rational R(z) for asin on [0, 1/4]: asin x ≈ x + x·R(x²) for |x| ≤ 1/2.
 #[inline(always)]
 fn asin_r<D: Vector64<N>, const N: usize>(z: D) -> D {
-    let c = D::splat;
-    let p = c(3.479_331_075_960_212e-5)
-        .mul(z)
-        .add(c(7.915_349_942_898_145e-4))
-        .mul(z)
-        .add(c(-4.005_553_450_067_941e-2))
-        .mul(z)
-        .add(c(2.012_125_321_348_629_3e-1))
-        .mul(z)
-        .add(c(-3.255_658_186_224_009e-1))
-        .mul(z)
-        .add(c(1.666_666_666_666_666_6e-1))
-        .mul(z);
-    let q = c(7.703_815_055_590_194e-2)
-        .mul(z)
-        .add(c(-6.882_839_716_054_533e-1))
-        .mul(z)
-        .add(c(2.020_945_760_233_505_7))
-        .mul(z)
-        .add(c(-2.403_394_911_734_414))
-        .mul(z)
-        .add(c(1.0));
+    let p = horner(
+        z,
+        [
+            3.479_331_075_960_212e-5,
+            7.915_349_942_898_145e-4,
+            -4.005_553_450_067_941e-2,
+            2.012_125_321_348_629_3e-1,
+            -3.255_658_186_224_009e-1,
+            1.666_666_666_666_666_6e-1,
+        ],
+    )
+    .mul(z);
+    let q = horner(
+        z,
+        [
+            7.703_815_055_590_194e-2,
+            -6.882_839_716_054_533e-1,
+            2.020_945_760_233_505_7,
+            -2.403_394_911_734_414,
+            1.0,
+        ],
+    );
     p.div(q)
 }
 

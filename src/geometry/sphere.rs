@@ -2,7 +2,7 @@
 //! samples, never a tessellation, or light and geometry would disagree.
 
 use super::Ray;
-use crate::simd::{Vector64, WIDTH};
+use crate::simd::{Vector64, WIDTH, dot3};
 use crate::tracer::RayPacket;
 use glam::Vec3;
 
@@ -72,7 +72,7 @@ impl Sphere {
             D::from_f32(&rays.dy),
             D::from_f32(&rays.dz),
         ];
-        let b = dot3(&f, &dir).neg();
+        let b = dot3(f, dir).neg();
         let perp = [
             f[0].add(dir[0].mul(b)),
             f[1].add(dir[1].mul(b)),
@@ -81,9 +81,9 @@ impl Sphere {
         let r = self.radius as f64;
         let r2 = D::splat(r * r);
         let zero = D::splat(0.0);
-        let disc = r2.sub(dot3(&perp, &perp));
+        let disc = r2.sub(dot3(perp, perp));
         let mut hit = m & !disc.lt(zero);
-        let c = dot3(&f, &f).sub(r2);
+        let c = dot3(f, f).sub(r2);
         // b.signum(): −1 where the sign bit is set (−0.0 included).
         let sign = D::select(b.sign(), D::splat(-1.0), D::splat(1.0));
         let q = b.add(sign.mul(D::select(hit, disc, zero).sqrt()));
@@ -128,13 +128,6 @@ impl Sphere {
         let local = (p - self.center).abs();
         gamma(6) * local + gamma(1) * self.center.abs()
     }
-}
-
-/// glam's dot product order, (x·x′ + y·y′) + z·z′, over f64 lanes. A function, not a closure,
-/// so that it inlines into the ISA's entry.
-#[inline(always)]
-fn dot3<D: Vector64<WIDTH>>(a: &[D; 3], b: &[D; 3]) -> D {
-    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
 }
 
 #[cfg(test)]

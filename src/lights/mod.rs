@@ -737,6 +737,7 @@ pub fn selection_number(hi: f32, lo: f32) -> f64 {
 #[cfg(test)]
 pub(crate) mod lane_tests {
     use super::*;
+    use crate::sampling::stream::{ONE_MINUS_EPSILON, SampleStream};
 
     fn bits(s: Option<LightSample>) -> Option<([u32; 16], bool)> {
         s.map(|s| {
@@ -751,6 +752,29 @@ pub(crate) mod lane_tests {
             }
             (b, s.distant)
         })
+    }
+
+    /// Lane `lane`'s sample numbers in round `round`: u at 0 and just below 1 among random ones.
+    pub(crate) fn set_numbers(
+        q: &mut LaneQuery,
+        lane: usize,
+        round: usize,
+        rng: &mut SampleStream,
+    ) {
+        let [u0, u1] = rng.next_2d();
+        let special = [0.0, ONE_MINUS_EPSILON, u0, u1];
+        q.u[0][lane] = special[(lane + round) % 4];
+        q.u[1][lane] = special[(lane + 2 * round) % 4];
+        q.u[2][lane] = rng.next_2d()[0];
+    }
+
+    /// Every lane in even rounds, a random mask in odd ones.
+    pub(crate) fn active_lanes(round: usize, rng: &mut SampleStream) -> u32 {
+        if round.is_multiple_of(2) {
+            u32::MAX >> (32 - WIDTH)
+        } else {
+            (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
+        }
     }
 
     /// `light.sample_lanes` of lanes `active` equals `light.sample` lane by lane, bit for bit,

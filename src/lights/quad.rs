@@ -9,8 +9,8 @@ use super::{
 };
 use crate::math::gamma;
 use crate::math::luminance;
-use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle, d3};
-use crate::simd::{self, Isa, Kernel, Lanes, V3, Vector, Vector64, WIDTH};
+use crate::sampling::spherical::{MIN_SOLID_ANGLE, SphericalRectangle};
+use crate::simd::{self, Isa, Kernel, Lanes, V3, Vector, Vector64, WIDTH, dot3};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -162,24 +162,16 @@ impl QuadLight {
         // spherical_rect: the corner relative to p, rounded in f32 and then widened.
         let rel = corner32 - p;
         let corner = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
-        let n = d3(self.normal.as_dvec3()).map(D::splat);
-        let front = corner[0]
-            .mul(n[0])
-            .add(corner[1].mul(n[1]))
-            .add(corner[2].mul(n[2]))
-            .lt(D::splat(0.0));
+        let n = self.normal.as_dvec3().to_array().map(D::splat);
+        let front = dot3(corner, n).lt(D::splat(0.0));
         let (ex, ey) = (
-            d3(self.edge_u.as_dvec3()).map(D::splat),
-            d3(self.edge_v.as_dvec3()).map(D::splat),
+            self.edge_u.as_dvec3().to_array().map(D::splat),
+            self.edge_v.as_dvec3().to_array().map(D::splat),
         );
         let (rect, ok) = SphericalRectangle::<D>::lanes(corner, ex, ey);
         let solid = faces & front & ok & D::splat(MIN_SOLID_ANGLE).le(rect.area());
         let d = rect.sample_lanes(D::from_f32(&q.u[0]), D::from_f32(&q.u[1]));
-        let dist = d[0]
-            .mul(d[0])
-            .add(d[1].mul(d[1]))
-            .add(d[2].mul(d[2]))
-            .sqrt();
+        let dist = dot3(d, d).sqrt();
         let wi = V3 {
             x: f32s::<V, D>(d[0].div(dist)),
             y: f32s::<V, D>(d[1].div(dist)),
@@ -379,7 +371,8 @@ fn chi2_case(
 mod tests {
     use super::*;
     use crate::lights::LightMethods;
-    use crate::sampling::stream::{ONE_MINUS_EPSILON, SampleStream};
+    use crate::lights::lane_tests;
+    use crate::sampling::stream::SampleStream;
 
     /// Spherical-rectangle samples of sixteen lanes at once are the scalar ones, bit for bit,
     /// on every ISA, for a rectangle with no axis-aligned edge: points in front of it near and
@@ -403,11 +396,7 @@ mod tests {
         // Lanes of each kind the scalar sampler tells apart: no sample, area, solid angle.
         let mut kinds = [0usize; 3];
         for round in 0..400 {
-            let mut q = LaneQuery {
-                p: Default::default(),
-                n: Default::default(),
-                u: [[0.0; WIDTH]; 3],
-            };
+            let mut q = LaneQuery::default();
             for lane in 0..WIDTH {
                 let [a, b] = rng.next_2d();
                 let [s, t] = rng.next_2d();
@@ -423,26 +412,16 @@ mod tests {
                 };
                 q.p.set(lane, p);
                 q.n.set(lane, -up);
-                let [u0, u1] = rng.next_2d();
-                let special = [0.0, ONE_MINUS_EPSILON, u0, u1];
-                q.u[0][lane] = special[(lane + round) % 4];
-                q.u[1][lane] = special[(lane + 2 * round) % 4];
-                q.u[2][lane] = rng.next_2d()[0];
+                lane_tests::set_numbers(&mut q, lane, round, &mut rng);
                 kinds[match (light.faces(p), light.spherical_rect(p)) {
                     (false, _) => 0,
                     (true, None) => 1,
                     (true, Some(_)) => 2,
                 }] += 1;
             }
-            let active = if round % 2 == 0 {
-                u32::MAX >> (32 - WIDTH)
-            } else {
-                (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
-            };
+            let active = lane_tests::active_lanes(round, &mut rng);
             let label = format!("round {round}");
-            crate::lights::lane_tests::assert_lanes_are_the_scalar_samples(
-                &light, &q, active, &m, &label,
-            );
+            lane_tests::assert_lanes_are_the_scalar_samples(&light, &q, active, &m, &label);
         }
         assert!(kinds.iter().all(|&k| k > 400), "{kinds:?}");
     }

@@ -575,7 +575,7 @@ fn chi2_case(
 mod tests {
     use super::*;
     use crate::lights::LightMethods;
-    use crate::sampling::stream::ONE_MINUS_EPSILON;
+    use crate::lights::lane_tests;
     use crate::sampling::stream::SampleStream;
 
     /// Cone samples of sixteen lanes at once are the scalar ones, bit for bit, on every ISA:
@@ -591,11 +591,7 @@ mod tests {
         let m = LightMethods::BASIC;
         let mut rng = SampleStream::new(3, 1, 4, 1);
         for round in 0..400 {
-            let mut q = LaneQuery {
-                p: Default::default(),
-                n: Default::default(),
-                u: [[0.0; WIDTH]; 3],
-            };
+            let mut q = LaneQuery::default();
             for lane in 0..WIDTH {
                 let [a, b] = rng.next_2d();
                 let dir = crate::sampling::warp::sample_uniform_sphere([a, b]);
@@ -608,21 +604,11 @@ mod tests {
                 };
                 q.p.set(lane, light.center + dir * dist);
                 q.n.set(lane, -dir);
-                let [u0, u1] = rng.next_2d();
-                let special = [0.0, ONE_MINUS_EPSILON, u0, u1];
-                q.u[0][lane] = special[(lane + round) % 4];
-                q.u[1][lane] = special[(lane + 2 * round) % 4];
-                q.u[2][lane] = rng.next_2d()[0];
+                lane_tests::set_numbers(&mut q, lane, round, &mut rng);
             }
-            let active = if round % 2 == 0 {
-                u32::MAX >> (32 - WIDTH)
-            } else {
-                (rng.next_2d()[0] * (1u32 << WIDTH) as f32) as u32
-            };
+            let active = lane_tests::active_lanes(round, &mut rng);
             let label = format!("round {round}");
-            crate::lights::lane_tests::assert_lanes_are_the_scalar_samples(
-                &light, &q, active, &m, &label,
-            );
+            lane_tests::assert_lanes_are_the_scalar_samples(&light, &q, active, &m, &label);
         }
     }
 }

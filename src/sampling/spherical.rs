@@ -5,7 +5,7 @@
 //! in sampler and pdf.
 
 use crate::math::{acos64, sin_cos64};
-use crate::simd::Vector64;
+use crate::simd::{D3, Vector64, cross3, div3, dot3, normalize3, scale3};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -93,57 +93,17 @@ impl SphericalTriangle {
     }
 }
 
-/// f64 three-vectors as lanes (`[x, y, z]`), for the rectangle written over lanes.
-pub type D3<D> = [D; 3];
-
-#[inline(always)]
-fn dot<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D {
-    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
-}
-
-#[inline(always)]
-fn cross<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D3<D> {
-    [
-        a[1].mul(b[2]).sub(b[1].mul(a[2])),
-        a[2].mul(b[0]).sub(b[2].mul(a[0])),
-        a[0].mul(b[1]).sub(b[0].mul(a[1])),
-    ]
-}
-
-// Functions, not closures: a closure is not always inlined into the ISA's entry, and outside
-// it its vector operations are calls.
-#[inline(always)]
-fn scale<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
-    [a[0].mul(s), a[1].mul(s), a[2].mul(s)]
-}
-
-#[inline(always)]
-fn div3<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
-    [a[0].div(s), a[1].div(s), a[2].div(s)]
-}
-
 /// The interior angle at the shared edge of two of the rectangle's planes, by their normals.
 /// The clamp keeps acos in its domain under rounding only.
 #[inline(always)]
 fn angle<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D {
-    acos64(clamp(dot(a, b).neg(), D::splat(-1.0), D::splat(1.0)))
-}
-
-/// `a` times 1/|a|, as glam normalises.
-#[inline(always)]
-fn normalize<D: Vector64<N>, const N: usize>(a: D3<D>) -> D3<D> {
-    scale(a, D::splat(1.0).div(dot(a, a).sqrt()))
+    acos64(clamp(dot3(a, b).neg(), D::splat(-1.0), D::splat(1.0)))
 }
 
 /// `x` clamped to [lo, hi] (lo ≤ hi).
 #[inline(always)]
 fn clamp<D: Vector64<N>, const N: usize>(x: D, lo: D, hi: D) -> D {
     x.max(lo).min(hi)
-}
-
-/// One-lane [`D3`] of a `DVec3`.
-pub fn d3(v: DVec3) -> D3<f64> {
-    v.to_array()
 }
 
 /// A rectangle corner + s·ex·len_x + t·ey·len_y seen from the origin (Ureña et al. 2013, §3),
@@ -169,7 +129,7 @@ impl SphericalRectangle<f64> {
     /// `corner` relative to the viewpoint; `ex`, `ey` orthogonal edges. None when the viewpoint
     /// lies in the rectangle's plane (zero solid angle).
     pub fn new(corner: DVec3, ex: DVec3, ey: DVec3) -> Option<Self> {
-        let (r, valid) = Self::lanes(d3(corner), d3(ex), d3(ey));
+        let (r, valid) = Self::lanes(corner.to_array(), ex.to_array(), ey.to_array());
         (valid != 0).then_some(r)
     }
 
@@ -189,26 +149,26 @@ impl<D: Copy> SphericalRectangle<D> {
         D: Vector64<N>,
     {
         let c = D::splat;
-        let (len_x, len_y) = (dot(ex, ex).sqrt(), dot(ey, ey).sqrt());
+        let (len_x, len_y) = (dot3(ex, ex).sqrt(), dot3(ey, ey).sqrt());
         let (x, y) = (div3(ex, len_x), div3(ey, len_y));
-        let z = cross(x, y);
-        let z0 = dot(corner, z);
+        let z = cross3(x, y);
+        let z0 = dot3(corner, z);
         let flip = c(0.0).lt(z0);
-        let z = scale(z, D::select(flip, c(-1.0), c(1.0)));
+        let z = scale3(z, D::select(flip, c(-1.0), c(1.0)));
         let z0 = D::select(flip, z0.neg(), z0);
         let mut valid = !z0.eq(c(0.0));
         // A lane in the plane takes z0 = −1 instead, so that no normal below is 0/0.
         let z0 = D::select(valid, z0, c(-1.0));
-        let (x0, y0) = (dot(corner, x), dot(corner, y));
+        let (x0, y0) = (dot3(corner, x), dot3(corner, y));
         let (x1, y1) = (x0.add(len_x), y0.add(len_y));
         let v00 = [x0, y0, z0];
         let v01 = [x0, y1, z0];
         let v10 = [x1, y0, z0];
         let v11 = [x1, y1, z0];
-        let n0 = normalize(cross(v00, v10));
-        let n1 = normalize(cross(v10, v11));
-        let n2 = normalize(cross(v11, v01));
-        let n3 = normalize(cross(v01, v00));
+        let n0 = normalize3(cross3(v00, v10));
+        let n1 = normalize3(cross3(v10, v11));
+        let n2 = normalize3(cross3(v11, v01));
+        let n3 = normalize3(cross3(v01, v00));
         let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
         let k = c(2.0 * PI).sub(g2).sub(g3);
         let area = g0.add(g1).sub(k);
@@ -270,7 +230,11 @@ impl<D: Copy> SphericalRectangle<D> {
             self.y1,
         );
         let yv = clamp(yv, self.y0, self.y1);
-        let (a, b, e) = (scale(self.x, xu), scale(self.y, yv), scale(self.z, self.z0));
+        let (a, b, e) = (
+            scale3(self.x, xu),
+            scale3(self.y, yv),
+            scale3(self.z, self.z0),
+        );
         [
             a[0].add(b[0]).add(e[0]),
             a[1].add(b[1]).add(e[1]),

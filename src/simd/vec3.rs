@@ -2,7 +2,7 @@
 //! `Vec3` operations in glam's order (`dot` is `(x·x' + y·y') + z·z'`, `normalize` multiplies
 //! by `1 / length`), so a kernel over lanes rounds exactly as the scalar code it mirrors.
 
-use super::{Vector, WIDTH};
+use super::{Vector, Vector64, WIDTH};
 use glam::Vec3;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -143,4 +143,41 @@ impl<V: Vector<WIDTH>> Neg for V3<V> {
             z: self.z.neg(),
         }
     }
+}
+
+/// f64 three-vectors over lanes (`[x, y, z]`), for the kernels whose numerics need f64, with
+/// glam's `DVec3` operations in glam's order. Functions, not closures: a closure is not always
+/// inlined into the ISA's entry, and outside it its vector operations are calls.
+pub type D3<D> = [D; 3];
+
+/// `(x·x′ + y·y′) + z·z′`.
+#[inline(always)]
+pub fn dot3<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D {
+    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
+}
+
+#[inline(always)]
+pub fn cross3<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D3<D> {
+    [
+        a[1].mul(b[2]).sub(b[1].mul(a[2])),
+        a[2].mul(b[0]).sub(b[2].mul(a[0])),
+        a[0].mul(b[1]).sub(b[0].mul(a[1])),
+    ]
+}
+
+#[inline(always)]
+pub fn scale3<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
+    [a[0].mul(s), a[1].mul(s), a[2].mul(s)]
+}
+
+/// Each component divided by `s` (not multiplied by 1/s).
+#[inline(always)]
+pub fn div3<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
+    [a[0].div(s), a[1].div(s), a[2].div(s)]
+}
+
+/// `a` times 1/|a|, as glam normalises.
+#[inline(always)]
+pub fn normalize3<D: Vector64<N>, const N: usize>(a: D3<D>) -> D3<D> {
+    scale3(a, D::splat(1.0).div(dot3(a, a).sqrt()))
 }
