@@ -374,16 +374,32 @@ impl<'a> Renderer<'a> {
                     self.estimator()
                         .env_weight_packet(&tile.points, &probes, &dirs, escaped);
             }
+            // The emitting surfaces the rest found, weighted over lanes.
+            let mut surfaces: [Option<SurfaceHit>; LANES] = [None; LANES];
+            let mut le = [Vec3::ZERO; LANES];
             for lane in 0..LANES {
-                let (Some(probe), Some(sp)) = (probes[lane].emission, &tile.points[lane]) else {
+                let (Some(probe), Some(_)) = (probes[lane].emission, &tile.points[lane]) else {
                     continue;
                 };
-                radiance[lane] += match ehits.get(lane) {
+                match ehits.get(lane) {
                     Some(hit) => {
-                        emission_contribution(&self.view, self.estimator(), sp, &probe, &hit)
+                        if let Some((surf, l)) = emitted_at(&self.view, &probe, &hit) {
+                            surfaces[lane] = Some(surf);
+                            le[lane] = l;
+                        }
                     }
-                    None => escape_weighted(&probe, env[lane], env_weight[lane]),
-                };
+                    None => radiance[lane] += escape_weighted(&probe, env[lane], env_weight[lane]),
+                }
+            }
+            if surfaces.iter().any(Option::is_some) {
+                let w = self
+                    .estimator()
+                    .emission_weight_packet(&tile.points, &probes, &surfaces);
+                for lane in 0..LANES {
+                    if let (Some(probe), Some(_)) = (probes[lane].emission, surfaces[lane]) {
+                        radiance[lane] += probe.weight * le[lane] * w[lane];
+                    }
+                }
             }
         }
         radiance
@@ -525,15 +541,23 @@ pub fn emission_contribution(
     probe: &EmissionProbe,
     hit: &crate::geometry::Hit,
 ) -> Vec3 {
-    if view.world.prim_emitter[hit.prim as usize].is_none() {
-        return Vec3::ZERO;
+    match emitted_at(view, probe, hit) {
+        Some((surf, le)) => probe.weight * le * estimator.emission_weight(sp, probe, &surf),
+        None => Vec3::ZERO,
     }
+}
+
+/// The emitting surface an emission probe hit and the radiance Le it sends back along the
+/// probe's ray; None where it sends none.
+fn emitted_at(
+    view: &SceneView,
+    probe: &EmissionProbe,
+    hit: &crate::geometry::Hit,
+) -> Option<(SurfaceHit, Vec3)> {
+    view.world.prim_emitter[hit.prim as usize]?;
     let surf = view.world.surface(&probe.ray, hit);
     let le = view.emitted(&surf, probe.ray.dir);
-    if le == Vec3::ZERO {
-        return Vec3::ZERO;
-    }
-    probe.weight * le * estimator.emission_weight(sp, probe, &surf)
+    (le != Vec3::ZERO).then_some((surf, le))
 }
 
 #[cfg(test)]

@@ -423,6 +423,52 @@ pub fn sample_lane_by_lane<T: Light + ?Sized>(
     }
 }
 
+/// Surface points on one light seen from the shading points of a packet's lanes (structure of
+/// arrays): what [`Light::pdf_lanes`] takes.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SurfaceLanes {
+    /// The shading points' positions and normals ([`LaneQuery::ctx`]; its `u` is not read).
+    pub from: LaneQuery,
+    /// The points on the light.
+    pub q: Soa3,
+    /// The light's part each point is on ([`LightHit::Surface`]'s `local`).
+    pub local: [u32; WIDTH],
+}
+
+impl SurfaceLanes {
+    /// Lane `lane` of `self` as a scalar query: where it is seen from, and what it hit.
+    pub fn get(&self, lane: usize) -> (LightCtx, LightHit) {
+        let hit = LightHit::Surface {
+            q: self.q.get(lane),
+            local: self.local[lane],
+        };
+        (self.from.ctx(lane), hit)
+    }
+
+    pub fn set(&mut self, lane: usize, ctx: &LightCtx, q: Vec3, local: u32) {
+        self.from.p.set(lane, ctx.p);
+        self.from.n.set(lane, ctx.n);
+        self.q.set(lane, q);
+        self.local[lane] = local;
+    }
+}
+
+/// [`Light::pdf_lanes`] lane by lane: the scalar [`Light::pdf`] of each lane of `active`.
+pub fn pdf_lane_by_lane<T: Light + ?Sized>(
+    light: &T,
+    at: &SurfaceLanes,
+    active: u32,
+    m: &LightMethods,
+    out: &mut [f32; WIDTH],
+) {
+    for (lane, o) in out.iter_mut().enumerate() {
+        if active >> lane & 1 != 0 {
+            let (ctx, hit) = at.get(lane);
+            *o = light.pdf(&ctx, hit, m);
+        }
+    }
+}
+
 /// pbrt-v4's ShadowEpsilon: a shadow segment stops this fraction short of the (offset) light
 /// point.
 pub const SHADOW_EPSILON: f32 = 1e-4;
@@ -553,6 +599,22 @@ pub trait Light: Send + Sync + std::fmt::Debug {
     /// Solid-angle pdf with which [`Self::sample`] (same method) produces the direction to
     /// `at`. 0 for delta lights: no direction found by another strategy can reach them.
     fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32;
+
+    /// [`Self::pdf`] for the lanes of `active` at once, on the lane layer's `isa`: lane i of
+    /// `out` is the pdf of surface point `at[i]` (part `local[i]`) seen from `q.ctx(i)`, bit
+    /// for bit as [`Self::pdf`] (`q.u` is not read; other lanes of `out` are kept). The
+    /// default is lane by lane; a light with a kernel over lanes overrides it (the MIS weight
+    /// of emission probes that hit it, #19 part B).
+    fn pdf_lanes(
+        &self,
+        _isa: Isa,
+        at: &SurfaceLanes,
+        active: u32,
+        m: &LightMethods,
+        out: &mut [f32; WIDTH],
+    ) {
+        pdf_lane_by_lane(self, at, active, m, out)
+    }
 
     /// Radiance leaving part `local` of the light at a point with outward geometric normal
     /// `n` towards direction `w` (unit, pointing away from the light). Zero for lights without
@@ -692,6 +754,40 @@ impl LightSet {
         sel.pmf(ctx, light) * self.lights[light].pdf(ctx, at, m)
     }
 
+    /// [`Self::pdf`] for the lanes of `active` (0 in the others): lane i's point on light
+    /// `light[i]`, each light's pdf taken over the lanes that hit it, the selection pmf after
+    /// it in the scalar order (pmf · pdf).
+    pub fn pdf_packet(
+        &self,
+        isa: Isa,
+        sel: &dyn LightSelector,
+        light: &[u32; WIDTH],
+        at: &SurfaceLanes,
+        active: u32,
+        m: &LightMethods,
+    ) -> [f32; WIDTH] {
+        let mut pdf = [0.0f32; WIDTH];
+        let mut rest = active;
+        while rest != 0 {
+            let i = light[rest.trailing_zeros() as usize];
+            let mut mask = 0;
+            for (lane, &l) in light.iter().enumerate() {
+                if l == i {
+                    mask |= 1 << lane;
+                }
+            }
+            mask &= active;
+            rest &= !mask;
+            self.lights[i as usize].pdf_lanes(isa, at, mask, m, &mut pdf);
+        }
+        for (lane, o) in pdf.iter_mut().enumerate() {
+            if active >> lane & 1 != 0 {
+                *o *= sel.pmf(&at.from.ctx(lane), light[lane] as usize);
+            }
+        }
+        pdf
+    }
+
     /// The pdf with which [`Self::sample`] produces direction `wi` towards the environment;
     /// 0 without one.
     pub fn env_pdf(
@@ -812,6 +908,37 @@ pub(crate) mod lane_tests {
                     bits(want),
                     "{isa:?} {label} lane {lane} p {:?}",
                     q.p.get(lane)
+                );
+            }
+        }
+    }
+
+    /// `light.pdf_lanes` of lanes `active` equals `light.pdf` lane by lane, bit for bit, on
+    /// every ISA, and lanes outside `active` keep what they held.
+    pub(crate) fn assert_lane_pdfs_are_the_scalar_ones<T: Light>(
+        light: &T,
+        at: &SurfaceLanes,
+        active: u32,
+        m: &LightMethods,
+        label: &str,
+    ) {
+        const MARKER: f32 = -3.5;
+        for isa in Isa::available() {
+            let mut out = [MARKER; WIDTH];
+            light.pdf_lanes(isa, at, active, m, &mut out);
+            for (lane, got) in out.iter().enumerate() {
+                let want = if active >> lane & 1 != 0 {
+                    let (ctx, hit) = at.get(lane);
+                    light.pdf(&ctx, hit, m)
+                } else {
+                    MARKER
+                };
+                assert_eq!(
+                    got.to_bits(),
+                    want.to_bits(),
+                    "{isa:?} {label} lane {lane}: {got} against {want}, p {:?}, q {:?}",
+                    at.from.p.get(lane),
+                    at.q.get(lane)
                 );
             }
         }

@@ -5,7 +5,7 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
-    QuadMethod, d64, direction_to, f32s, keep,
+    QuadMethod, SurfaceLanes, d64, direction_to, f32s, keep,
 };
 use crate::math::gamma;
 use crate::math::luminance;
@@ -155,21 +155,8 @@ impl QuadLight {
         a: u32,
         out: &mut LaneSamples,
     ) {
-        let zero = V::splat(0.0);
         let p = V3::<V>::load(&q.p);
-        let corner32 = V3::splat(self.corner);
-        let faces = a & zero.lt((p - corner32).dot(V3::splat(self.normal)));
-        // spherical_rect: the corner relative to p, rounded in f32 and then widened.
-        let rel = corner32 - p;
-        let corner = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
-        let n = self.normal.as_dvec3().to_array().map(D::splat);
-        let front = dot3(corner, n).lt(D::splat(0.0));
-        let (ex, ey) = (
-            self.edge_u.as_dvec3().to_array().map(D::splat),
-            self.edge_v.as_dvec3().to_array().map(D::splat),
-        );
-        let (rect, ok) = SphericalRectangle::<D>::lanes(corner, ex, ey);
-        let solid = faces & front & ok & D::splat(MIN_SOLID_ANGLE).le(rect.area());
+        let (rect, faces, solid) = self.spherical_rect_lanes::<V, D>(p, a);
         let d = rect.sample_lanes(D::from_f32(&q.u[0]), D::from_f32(&q.u[1]));
         let dist = dot3(d, d).sqrt();
         let wi = V3 {
@@ -195,6 +182,63 @@ impl QuadLight {
         out.valid = (out.valid & !(a & !faces)) | solid;
         out.distant &= !solid;
         self.sample_area_lanes::<V>(q, faces & !solid, out);
+    }
+
+    /// [`Self::faces`] and [`Self::spherical_rect`] for the lanes of `a` seen from `p`: the
+    /// rectangles, the lanes that face the emitting side, and those of them whose rectangle
+    /// is sampled (the others fall back to area sampling). Other lanes' rectangles hold finite
+    /// values that mean nothing.
+    #[inline(always)]
+    fn spherical_rect_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+        &self,
+        p: V3<V>,
+        a: u32,
+    ) -> (SphericalRectangle<D>, u32, u32) {
+        let corner32 = V3::splat(self.corner);
+        let faces = a & V::splat(0.0).lt((p - corner32).dot(V3::splat(self.normal)));
+        // The corner relative to p, rounded in f32 and then widened.
+        let rel = corner32 - p;
+        let corner = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
+        let n = self.normal.as_dvec3().to_array().map(D::splat);
+        let front = dot3(corner, n).lt(D::splat(0.0));
+        let (ex, ey) = (
+            self.edge_u.as_dvec3().to_array().map(D::splat),
+            self.edge_v.as_dvec3().to_array().map(D::splat),
+        );
+        let (rect, ok) = SphericalRectangle::<D>::lanes(corner, ex, ey);
+        let solid = faces & front & ok & D::splat(MIN_SOLID_ANGLE).le(rect.area());
+        (rect, faces, solid)
+    }
+
+    /// [`Self::pdf_area`] of every lane of `at`, the same operations in the same order (lanes
+    /// whose point is their viewpoint, which no hit is, hold values that mean nothing).
+    #[inline(always)]
+    fn pdf_area_lanes<V: Vector<WIDTH>>(&self, at: &SurfaceLanes) -> V {
+        let zero = V::splat(0.0);
+        let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
+        let d2 = d.dot(d);
+        let cos_l = V3::splat(self.normal).dot(d).neg().div(d2.sqrt());
+        V::select(zero.lt(cos_l), d2.div(V::splat(self.area).mul(cos_l)), zero)
+    }
+
+    /// [`Self::pdf_solid_angle`] for the lanes of `a`, bit for bit; other lanes of `out` are
+    /// kept.
+    #[inline(always)]
+    fn pdf_solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+        &self,
+        at: &SurfaceLanes,
+        a: u32,
+        out: &mut [f32; WIDTH],
+    ) {
+        let zero = V::splat(0.0);
+        let (rect, faces, solid) = self.spherical_rect_lanes::<V, D>(V3::load(&at.from.p), a);
+        let mut pdf = V::select(solid, f32s::<V, D>(D::splat(1.0).div(rect.area())), zero);
+        // Tiny rectangles were sampled by area (rare: only then is that pdf computed).
+        let by_area = faces & !solid;
+        if by_area != 0 {
+            pdf = V::select(by_area, self.pdf_area_lanes::<V>(at), pdf);
+        }
+        V::select(a, pdf, V::load(out)).store(out);
     }
 
     pub fn pdf_solid_angle(&self, p: Vec3, q: Vec3) -> f32 {
@@ -277,6 +321,38 @@ impl Light for QuadLight {
         match m.quad {
             QuadMethod::Area => self.pdf_area(ctx.p, q),
             QuadMethod::SolidAngle => self.pdf_solid_angle(ctx.p, q),
+        }
+    }
+
+    fn pdf_lanes(
+        &self,
+        isa: Isa,
+        at: &SurfaceLanes,
+        active: u32,
+        m: &LightMethods,
+        out: &mut [f32; WIDTH],
+    ) {
+        struct Area<'a>(&'a QuadLight, &'a SurfaceLanes, u32, &'a mut [f32; WIDTH]);
+        impl Kernel for Area<'_> {
+            type Out = ();
+            #[inline(always)]
+            fn run<L: Lanes>(self) {
+                let pdf = self.0.pdf_area_lanes::<L::V>(self.1);
+                L::V::select(self.2, pdf, L::V::load(self.3)).store(self.3)
+            }
+        }
+        struct SolidAngle<'a>(&'a QuadLight, &'a SurfaceLanes, u32, &'a mut [f32; WIDTH]);
+        impl Kernel for SolidAngle<'_> {
+            type Out = ();
+            #[inline(always)]
+            fn run<L: Lanes>(self) {
+                self.0
+                    .pdf_solid_angle_lanes::<L::V, L::D>(self.1, self.2, self.3)
+            }
+        }
+        match m.quad {
+            QuadMethod::Area => simd::run(isa, Area(self, at, active, out)),
+            QuadMethod::SolidAngle => simd::run(isa, SolidAngle(self, at, active, out)),
         }
     }
 
@@ -379,50 +455,111 @@ mod tests {
     /// far, 1e-5 off its plane, in its plane, behind it, and so far away that the solid angle
     /// falls below `MIN_SOLID_ANGLE` (area sampling, in the same kernel); u at 0 and just
     /// below 1 among the numbers; lanes outside the mask keep what they held.
-    #[test]
-    fn solid_angle_lanes_are_the_scalar_samples_on_every_isa() {
+    /// The tilted lamp of `tests/lanes.rs` (no edge has a zero component, so every lane
+    /// operation's rounding shows).
+    fn tilted() -> QuadLight {
         let (eu, ev) = (
             Vec3::new(0.4, 0.2, 0.4),
             Vec3::new(-0.333_333_3, 0.333_333_3, 0.166_666_67),
         );
         let light = QuadLight::new(Vec3::new(-0.3, 1.5, 0.1), eu, ev, Vec3::new(3.0, 2.0, 1.0));
         assert!(light.is_rectangle());
+        light
+    }
+
+    /// A viewpoint of the kind `(lane + round) % 6`: far around the lamp, 1e-5 above its
+    /// plane, in it, behind it, so far that its solid angle falls below `MIN_SOLID_ANGLE`, or
+    /// just above it.
+    fn viewpoint(light: &QuadLight, kind: usize, rng: &mut SampleStream) -> Vec3 {
+        let (eu, ev, up) = (light.edge_u, light.edge_v, light.normal);
+        let centre = light.corner + 0.5 * (eu + ev);
+        let [a, b] = rng.next_2d();
+        let [s, t] = rng.next_2d();
+        let on_plane = light.corner + eu * (3.0 * s - 1.0) + ev * (3.0 * t - 1.0);
+        match kind % 6 {
+            0 => centre + crate::sampling::warp::sample_uniform_sphere([a, b]) * 3.0,
+            1 => on_plane + up * 1e-5,
+            2 => on_plane,
+            3 => on_plane - up * (0.1 + a),
+            4 => centre + up * 4e3 + eu * (a - 0.5) * 1e3,
+            _ => on_plane + up * (0.01 + a),
+        }
+    }
+
+    /// Which case of the scalar sampler `p` is: no sample, area, solid angle.
+    fn kind_of(light: &QuadLight, p: Vec3) -> usize {
+        match (light.faces(p), light.spherical_rect(p)) {
+            (false, _) => 0,
+            (true, None) => 1,
+            (true, Some(_)) => 2,
+        }
+    }
+
+    /// The solid-angle sampler over lanes is the scalar one bit for bit on every ISA, for
+    /// points behind the light, in its plane, 1e-5 off it, far and near, and so far that it
+    /// falls below `MIN_SOLID_ANGLE` (area sampling, in the same kernel); u at 0 and just
+    /// below 1 among the numbers; lanes outside the mask keep what they held.
+    #[test]
+    fn solid_angle_lanes_are_the_scalar_samples_on_every_isa() {
+        let light = tilted();
         let m = LightMethods {
             quad: QuadMethod::SolidAngle,
             ..LightMethods::BASIC
         };
-        let centre = light.corner + 0.5 * (eu + ev);
         let mut rng = SampleStream::new(5, 2, 6, 1);
-        // Lanes of each kind the scalar sampler tells apart: no sample, area, solid angle.
         let mut kinds = [0usize; 3];
         for round in 0..400 {
             let mut q = LaneQuery::default();
             for lane in 0..WIDTH {
-                let [a, b] = rng.next_2d();
-                let [s, t] = rng.next_2d();
-                let on_plane = light.corner + eu * (3.0 * s - 1.0) + ev * (3.0 * t - 1.0);
-                let up = light.normal;
-                let p = match (lane + round) % 6 {
-                    0 => centre + crate::sampling::warp::sample_uniform_sphere([a, b]) * 3.0,
-                    1 => on_plane + up * 1e-5,
-                    2 => on_plane,
-                    3 => on_plane - up * (0.1 + a),
-                    4 => centre + up * 4e3 + eu * (a - 0.5) * 1e3,
-                    _ => on_plane + up * (0.01 + a),
-                };
+                let p = viewpoint(&light, lane + round, &mut rng);
                 q.p.set(lane, p);
-                q.n.set(lane, -up);
+                q.n.set(lane, -light.normal);
                 lane_tests::set_numbers(&mut q, lane, round, &mut rng);
-                kinds[match (light.faces(p), light.spherical_rect(p)) {
-                    (false, _) => 0,
-                    (true, None) => 1,
-                    (true, Some(_)) => 2,
-                }] += 1;
+                kinds[kind_of(&light, p)] += 1;
             }
             let active = lane_tests::active_lanes(round, &mut rng);
             let label = format!("round {round}");
             lane_tests::assert_lanes_are_the_scalar_samples(&light, &q, active, &m, &label);
         }
         assert!(kinds.iter().all(|&k| k > 400), "{kinds:?}");
+    }
+
+    /// Both methods' pdfs over lanes ([`Light::pdf_lanes`], the MIS weight of emission probes
+    /// that hit the quad) are the scalar ones bit for bit on every ISA, from the viewpoints
+    /// above, at points on the quad, its corners and edges among them; lanes outside the
+    /// mask keep what they held.
+    #[test]
+    fn pdf_lanes_are_the_scalar_pdfs_on_every_isa() {
+        let light = tilted();
+        let mut rng = SampleStream::new(5, 3, 7, 2);
+        let mut kinds = [0usize; 3];
+        for method in QuadMethod::ALL {
+            let m = LightMethods {
+                quad: method,
+                ..LightMethods::BASIC
+            };
+            for round in 0..400 {
+                let mut at = SurfaceLanes::default();
+                for lane in 0..WIDTH {
+                    let p = viewpoint(&light, lane + round, &mut rng);
+                    let [s, t] = match lane % 4 {
+                        0 => [0.0, 0.0],
+                        1 => [1.0, rng.next_1d()],
+                        _ => rng.next_2d(),
+                    };
+                    let q = light.corner + light.edge_u * s + light.edge_v * t;
+                    let ctx = LightCtx {
+                        p,
+                        n: -light.normal,
+                    };
+                    at.set(lane, &ctx, q, 0);
+                    kinds[kind_of(&light, p)] += 1;
+                }
+                let active = lane_tests::active_lanes(round, &mut rng);
+                let label = format!("{method:?} round {round}");
+                lane_tests::assert_lane_pdfs_are_the_scalar_ones(&light, &at, active, &m, &label);
+            }
+        }
+        assert!(kinds.iter().all(|&k| k > 800), "{kinds:?}");
     }
 }

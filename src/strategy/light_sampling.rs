@@ -10,7 +10,9 @@ use crate::lights::selector::{LightSelector, SelectorType, default_selector};
 use crate::lights::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, SHADOW_EPSILON, selection_number,
 };
-use crate::lights::{LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride};
+use crate::lights::{
+    LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride, SurfaceLanes,
+};
 use crate::math::offset_ray_origin_lanes;
 use crate::prepare::SceneView;
 use crate::sampling::{Dimension, Dims, Layout};
@@ -336,6 +338,13 @@ impl<'s> BoundLights<'s> {
             LightHit::Surface { q, local },
             &self.methods,
         )
+    }
+
+    /// [`Self::pdf`] of the lanes of `active`, lane i's point `at.q[i]` on light `light[i]`
+    /// (0 in other lanes): each light's pdf over the lanes that hit it.
+    pub fn pdf_packet(&self, light: &[u32; LANES], at: &SurfaceLanes, active: u32) -> [f32; LANES] {
+        self.lights
+            .pdf_packet(self.isa, self.selector, light, at, active, &self.methods)
     }
 
     /// The pdf with which [`Self::probe`] samples direction `wi` towards the environment.

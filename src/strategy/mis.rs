@@ -14,7 +14,7 @@ use super::{
 use crate::bsdf::BsdfSampling;
 use crate::env::EnvMethod;
 use crate::lights::selector::{SelectorType, default_selector};
-use crate::lights::{LightMethods, LightShape};
+use crate::lights::{LightMethods, LightShape, SurfaceLanes};
 use crate::prepare::{SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout};
 use crate::simd::Soa3;
@@ -296,6 +296,37 @@ impl Estimator for MisEstimator<'_> {
         let Some(e) = hit.emitter else { return 1.0 };
         let p_light = self.lights.pdf(sp, e.light as usize, hit.p, e.local);
         self.strategy.heuristic.weight(probe.pdf, p_light)
+    }
+
+    fn emission_weight_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        probes: &[Probes; LANES],
+        hits: &[Option<SurfaceHit>; LANES],
+    ) -> [f32; LANES] {
+        let mut at = SurfaceLanes::default();
+        let mut light = [0u32; LANES];
+        let mut mask = 0u32;
+        for lane in 0..LANES {
+            if let (Some(sp), Some(_), Some(hit)) =
+                (&points[lane], &probes[lane].emission, &hits[lane])
+                && let Some(e) = hit.emitter
+            {
+                at.set(lane, &sp.light_ctx(), hit.p, e.local);
+                light[lane] = e.light;
+                mask |= 1 << lane;
+            }
+        }
+        let p_light = self.lights.pdf_packet(&light, &at, mask);
+        let mut out = [1.0f32; LANES];
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0
+                && let Some(probe) = &probes[lane].emission
+            {
+                *o = self.strategy.heuristic.weight(probe.pdf, p_light[lane]);
+            }
+        }
+        out
     }
 
     fn env_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe) -> f32 {

@@ -265,6 +265,26 @@ pub trait Estimator: Send + Sync {
         1.0
     }
 
+    /// [`Self::emission_weight`] of the emission probes of the lanes that have a hit in
+    /// `hits` (the renderer's emitting surfaces; the other lanes are not read and weigh 1),
+    /// lane by lane unless overridden.
+    fn emission_weight_packet(
+        &self,
+        points: &[Option<ShadingPoint>; LANES],
+        probes: &[Probes; LANES],
+        hits: &[Option<SurfaceHit>; LANES],
+    ) -> [f32; LANES] {
+        let mut out = [1.0f32; LANES];
+        for (lane, o) in out.iter_mut().enumerate() {
+            if let (Some(sp), Some(probe), Some(hit)) =
+                (&points[lane], &probes[lane].emission, &hits[lane])
+            {
+                *o = self.emission_weight(sp, probe, hit);
+            }
+        }
+        out
+    }
+
     /// Weight of environment radiance found by an emission probe that escaped (MIS overrides).
     fn env_weight(&self, _sp: &ShadingPoint, _probe: &EmissionProbe) -> f32 {
         1.0
