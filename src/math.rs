@@ -1,6 +1,6 @@
 //! Small numeric helpers shared by geometry, samplers and the renderer.
 
-use crate::simd::{V3, Vector, Vector64, WIDTH};
+use crate::simd::{V3, Vector, Vector64, VectorU64, WIDTH};
 use glam::Vec3;
 
 /// An orthonormal frame around a unit normal (Duff et al., "Building an Orthonormal Basis,
@@ -297,11 +297,18 @@ pub fn luminance(c: Vec3) -> f32 {
 }
 
 /// SplitMix64 finaliser: turns (seed, pixel, pass) tuples into independent stream seeds.
-pub fn mix64(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+#[inline]
+pub fn mix64(z: u64) -> u64 {
+    mix64_lanes(z)
+}
+
+/// [`mix64`] of every lane, written once over lanes (scalar code is one `u64` lane).
+#[inline(always)]
+pub fn mix64_lanes<U: VectorU64<N>, const N: usize>(z: U) -> U {
+    let z = z.add(U::splat(0x9E37_79B9_7F4A_7C15));
+    let z = z.xor(z.shr(30)).mul(U::splat(0xBF58_476D_1CE4_E5B9));
+    let z = z.xor(z.shr(27)).mul(U::splat(0x94D0_49BB_1331_11EB));
+    z.xor(z.shr(31))
 }
 
 #[cfg(test)]

@@ -4,8 +4,8 @@
 //! draws — the assumption the harness's error predictions make.
 
 use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
-use crate::simd::{Isa, Kernel, Lanes, Mask, WIDTH};
-use super::stream::SampleStream;
+use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
+use super::stream::{SampleStream, next_1d_lanes};
 
 pub struct Independent;
 
@@ -66,8 +66,7 @@ impl SampleGenerator for Independent {
     }
 }
 
-/// [`Independent::fill_lanes`]'s loops, run in the SIMD layer's ISA context so that they
-/// vectorise (integer lanes are plain arrays: the lane layer has no 64-bit type).
+/// [`Independent::fill_lanes`]'s streams over the lane layer's u64 lanes, in the ISA's context.
 struct FillLanes<'a> {
     base: [u64; WIDTH],
     pixel: [u64; WIDTH],
@@ -80,10 +79,12 @@ impl Kernel for FillLanes<'_> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
+        let load = L::U::load;
         let (mut state, increment) =
-            SampleStream::keyed_lanes(&self.base, &self.pixel, &self.pass);
+            SampleStream::keyed_lanes(load(&self.base), load(&self.pixel), load(&self.pass));
+        let mut x = [0.0f32; WIDTH];
         for d in 0..self.dims.min(MAX_DIMENSIONS) {
-            let x = SampleStream::next_1d_lanes(&mut state, &increment);
+            next_1d_lanes::<L::V, L::U>(&mut state, increment, &mut x);
             for (o, &x) in self.out.iter_mut().zip(x.iter()) {
                 o[d] = x;
             }

@@ -1,8 +1,8 @@
 //! Deterministic random streams: one PCG32 stream per (seed, strategy, pixel, pass), so an image
 //! depends on the seed and never on thread scheduling or tile order.
 
-use crate::math::mix64;
-use crate::simd::WIDTH;
+use crate::math::{mix64, mix64_lanes};
+use crate::simd::{Vector, VectorU64, WIDTH};
 
 /// PCG32 (O'Neill 2014: 64-bit LCG state, XSH-RR output), seeded exactly as
 /// `rand_pcg::Pcg32::seed_from_u64` seeds it, so every stream is bit-identical to the crate's
@@ -19,15 +19,42 @@ const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
 /// The increment of the PCG32 that `SeedableRng::seed_from_u64` draws seed words from.
 const SEED_INCREMENT: u64 = 11_634_580_027_462_260_723;
 
-/// XSH-RR: xorshift the high bits down, then rotate by the top five.
+/// XSH-RR of every lane (O'Neill 2014, §6.3.1): xorshift the high bits down, then rotate the
+/// 32-bit word by the top five bits; each output in the low half of its lane. The rotation is
+/// the word doubled into 64 bits and shifted right.
 #[inline(always)]
-fn xsh_rr(state: u64) -> u32 {
-    let xsh = (((state >> 18) ^ state) >> 27) as u32;
-    xsh.rotate_right((state >> 59) as u32)
+fn xsh_rr<U: VectorU64<N>, const N: usize>(state: U) -> U {
+    let low = U::splat(0xffff_ffff);
+    let xsh = state.shr(18).xor(state).shr(27).and(low);
+    xsh.or(xsh.shl(32)).shr_lanes(state.shr(59)).and(low)
+}
+
+/// One LCG step of every lane.
+#[inline(always)]
+fn step<U: VectorU64<N>, const N: usize>(state: U, increment: U) -> U {
+    state.mul(U::splat(MULTIPLIER)).add(increment)
+}
+
+/// `seed_from_u64` of every lane: four words of a PCG32 started at `key` (advanced before
+/// each output) form the little-endian state and stream; the increment is made odd, added
+/// once, and the LCG stepped once. Returns (state, increment).
+#[inline(always)]
+fn seeded<U: VectorU64<N>, const N: usize>(key: U) -> (U, U) {
+    let seed_increment = U::splat(SEED_INCREMENT);
+    let s1 = step(key, seed_increment);
+    let s2 = step(s1, seed_increment);
+    let s3 = step(s2, seed_increment);
+    let s4 = step(s3, seed_increment);
+    let state = xsh_rr(s1).or(xsh_rr(s2).shl(32));
+    let increment = xsh_rr(s3).or(xsh_rr(s4).shl(32)).or(U::splat(1));
+    (step(state.add(increment), increment), increment)
 }
 
 /// The largest f32 below 1: samples live in [0, 1).
 pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// 2⁻²⁴: a 24-bit integer times it is exactly its value as a fraction in [0, 1).
+const TO_UNIT: f32 = 1.0 / 16_777_216.0;
 
 impl SampleStream {
     #[inline]
@@ -46,94 +73,62 @@ impl SampleStream {
     /// `base = Self::base(seed, strategy)`.
     #[inline]
     pub fn keyed(base: u64, pixel: u64, pass: u64) -> Self {
-        Self::from_u64(mix64(
-            mix64(base ^ pixel) ^ pass.wrapping_mul(0x9E37_79B9_7F4A_7C15),
-        ))
-    }
-
-    /// `seed_from_u64`: four words of a PCG32 started at `key` (advanced before each output)
-    /// form the little-endian state and stream; the increment is made odd, added once, and the
-    /// LCG stepped once.
-    #[inline(always)]
-    fn from_u64(key: u64) -> Self {
-        let mut s = key;
-        let mut word = || {
-            s = s.wrapping_mul(MULTIPLIER).wrapping_add(SEED_INCREMENT);
-            xsh_rr(s) as u64
-        };
-        let state = word() | word() << 32;
-        let increment = (word() | word() << 32) | 1;
-        let state = state
-            .wrapping_add(increment)
-            .wrapping_mul(MULTIPLIER)
-            .wrapping_add(increment);
+        let (state, increment) = Self::keyed_lanes(base, pixel, pass);
         SampleStream { state, increment }
     }
 
-    /// Sixteen streams side by side: the (state, increment) of `keyed(base[i], pixel[i],
-    /// pass[i])` for every lane i, written as plain loops over lanes. Called inside a SIMD
-    /// layer kernel they are compiled for its ISA and vectorise; integer operations only, so
-    /// every ISA gives the same bits.
+    /// [`Self::keyed`] of every lane, written once over lanes (scalar code is one `u64`
+    /// lane): the (state, increment) of each lane's stream. Integer operations only, so every
+    /// ISA gives the same bits.
     #[inline(always)]
-    #[allow(clippy::needless_range_loop)] // index loops are what vectorise here
-    pub fn keyed_lanes(
-        base: &[u64; WIDTH],
-        pixel: &[u64; WIDTH],
-        pass: &[u64; WIDTH],
-    ) -> ([u64; WIDTH], [u64; WIDTH]) {
-        // Plain loops, not `array::from_fn`: its closure is not inlined into the ISA's entry,
-        // and would run as scalar code outside it.
-        let mut key = [0u64; WIDTH];
-        for i in 0..WIDTH {
-            key[i] = mix64(mix64(base[i] ^ pixel[i]) ^ pass[i].wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        }
-        let mut words = [[0u64; WIDTH]; 4];
-        for w in &mut words {
-            for (k, w) in key.iter_mut().zip(w.iter_mut()) {
-                *k = k.wrapping_mul(MULTIPLIER).wrapping_add(SEED_INCREMENT);
-                *w = xsh_rr(*k) as u64;
-            }
-        }
-        let (mut state, mut increment) = ([0u64; WIDTH], [0u64; WIDTH]);
-        for i in 0..WIDTH {
-            increment[i] = (words[2][i] | words[3][i] << 32) | 1;
-            state[i] = (words[0][i] | words[1][i] << 32)
-                .wrapping_add(increment[i])
-                .wrapping_mul(MULTIPLIER)
-                .wrapping_add(increment[i]);
-        }
-        (state, increment)
+    pub fn keyed_lanes<U: VectorU64<N>, const N: usize>(base: U, pixel: U, pass: U) -> (U, U) {
+        let pass = pass.mul(U::splat(0x9E37_79B9_7F4A_7C15));
+        seeded(mix64_lanes(mix64_lanes(base.xor(pixel)).xor(pass)))
     }
 
-    /// [`Self::next_1d`] of each of sixteen streams given as (state, increment) lanes.
-    #[inline(always)]
-    #[allow(clippy::needless_range_loop)]
-    pub fn next_1d_lanes(state: &mut [u64; WIDTH], increment: &[u64; WIDTH]) -> [f32; WIDTH] {
-        let mut out = [0.0f32; WIDTH];
-        for i in 0..WIDTH {
-            let old = state[i];
-            state[i] = old.wrapping_mul(MULTIPLIER).wrapping_add(increment[i]);
-            out[i] = (xsh_rr(old) >> 8) as f32 * (1.0 / 16_777_216.0);
-        }
-        out
+    /// `seed_from_u64(key)`.
+    #[cfg(test)]
+    fn from_u64(key: u64) -> Self {
+        let (state, increment) = seeded(key);
+        SampleStream { state, increment }
     }
 
+    /// Every lane's next output as its top 24 bits (an integer below 2²⁴; times 2⁻²⁴ it is
+    /// [`Self::next_1d`]), its state stepped.
     #[inline(always)]
+    pub fn next_24_lanes<U: VectorU64<N>, const N: usize>(state: &mut U, increment: U) -> U {
+        let old = *state;
+        *state = step(old, increment);
+        xsh_rr(old).shr(8)
+    }
+
+    #[cfg(test)]
     fn next_u32(&mut self) -> u32 {
         let old = self.state;
-        self.state = old.wrapping_mul(MULTIPLIER).wrapping_add(self.increment);
-        xsh_rr(old)
+        self.state = step(old, self.increment);
+        xsh_rr(old) as u32
     }
 
     /// Uniform in [0, 1): the top 24 bits, exactly representable.
     #[inline(always)]
     pub fn next_1d(&mut self) -> f32 {
-        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+        Self::next_24_lanes(&mut self.state, self.increment) as f32 * TO_UNIT
     }
 
     pub fn next_2d(&mut self) -> [f32; 2] {
         [self.next_1d(), self.next_1d()]
     }
+}
+
+/// [`SampleStream::next_1d`] of the streams of `state` (lanes), as f32 lanes in `out`.
+#[inline(always)]
+pub fn next_1d_lanes<V: Vector<WIDTH>, U: VectorU64<WIDTH>>(
+    state: &mut U,
+    increment: U,
+    out: &mut [f32; WIDTH],
+) {
+    SampleStream::next_24_lanes(state, increment).to_f32(out);
+    V::load(out).mul(V::splat(TO_UNIT)).store(out);
 }
 
 /// A stable 64-bit id of a name (FNV-1a), so a strategy's random stream does not depend on its

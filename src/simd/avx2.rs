@@ -2,7 +2,7 @@
 //! deliberately not enabled, so the path rounds exactly like the others.
 #![cfg(target_arch = "x86_64")]
 
-use super::{Kernel, Lanes, NARROW, Vector, Vector64, WIDTH};
+use super::{Kernel, Lanes, NARROW, Vector, Vector64, VectorU64, WIDTH};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy)]
@@ -19,6 +19,7 @@ impl Lanes for Avx2 {
     type V = Y2;
     type W = Y;
     type D = YD;
+    type U = YU;
 }
 
 /// 8 lanes in one ymm register; also the AVX-512 path's narrow vector. Only ever used inside
@@ -379,6 +380,121 @@ impl Vector64<WIDTH> for YD {
                 _mm256_blendv_pd(b[2], a[2], expand64(m >> 8)),
                 _mm256_blendv_pd(b[3], a[3], expand64(m >> 12)),
             ])
+        }
+    }
+}
+
+/// 16 u64 lanes in four ymm registers (lanes 0–3, 4–7, 8–11, 12–15).
+#[derive(Clone, Copy)]
+pub struct YU([__m256i; 4]);
+
+macro_rules! opu {
+    ($name:ident, $f:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            let (a, b) = (self.0, o.0);
+            unsafe {
+                YU([
+                    $f(a[0], b[0]),
+                    $f(a[1], b[1]),
+                    $f(a[2], b[2]),
+                    $f(a[3], b[3]),
+                ])
+            }
+        }
+    };
+}
+
+/// The low 64 bits of a·b per lane from 32-bit products (AVX2 has no 64-bit multiply):
+/// lo·lo + (hi·lo + lo·hi)·2³².
+#[inline(always)]
+fn mullo_epi64(a: __m256i, b: __m256i) -> __m256i {
+    unsafe {
+        let lo = _mm256_mul_epu32(a, b);
+        let cross = _mm256_add_epi64(
+            _mm256_mul_epu32(_mm256_srli_epi64::<32>(a), b),
+            _mm256_mul_epu32(a, _mm256_srli_epi64::<32>(b)),
+        );
+        _mm256_add_epi64(lo, _mm256_slli_epi64::<32>(cross))
+    }
+}
+
+/// The low 32 bits of the four u64 lanes of `a` and of `b`, as eight i32 lanes (a's first).
+#[inline(always)]
+fn low_halves(a: __m256i, b: __m256i) -> __m256i {
+    unsafe {
+        let even = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+        let (a, b) = (
+            _mm256_permutevar8x32_epi32(a, even),
+            _mm256_permutevar8x32_epi32(b, even),
+        );
+        _mm256_permute2x128_si256::<0x20>(a, b)
+    }
+}
+
+impl VectorU64<WIDTH> for YU {
+    #[inline(always)]
+    fn splat(x: u64) -> Self {
+        unsafe { YU([_mm256_set1_epi64x(x as i64); 4]) }
+    }
+    #[inline(always)]
+    fn load(a: &[u64; WIDTH]) -> Self {
+        let p = a.as_ptr() as *const __m256i;
+        unsafe {
+            YU([
+                _mm256_loadu_si256(p),
+                _mm256_loadu_si256(p.add(1)),
+                _mm256_loadu_si256(p.add(2)),
+                _mm256_loadu_si256(p.add(3)),
+            ])
+        }
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [u64; WIDTH]) {
+        let p = a.as_mut_ptr() as *mut __m256i;
+        unsafe {
+            for (i, v) in self.0.iter().enumerate() {
+                _mm256_storeu_si256(p.add(i), *v);
+            }
+        }
+    }
+    opu!(add, _mm256_add_epi64);
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        let (a, b) = (self.0, o.0);
+        YU([
+            mullo_epi64(a[0], b[0]),
+            mullo_epi64(a[1], b[1]),
+            mullo_epi64(a[2], b[2]),
+            mullo_epi64(a[3], b[3]),
+        ])
+    }
+    opu!(xor, _mm256_xor_si256);
+    opu!(or, _mm256_or_si256);
+    opu!(and, _mm256_and_si256);
+    opu!(shr_lanes, _mm256_srlv_epi64);
+    #[inline(always)]
+    fn shr(self, k: u32) -> Self {
+        unsafe {
+            let k = _mm_cvtsi32_si128(k as i32);
+            YU(self.0.map(|v| _mm256_srl_epi64(v, k)))
+        }
+    }
+    #[inline(always)]
+    fn shl(self, k: u32) -> Self {
+        unsafe {
+            let k = _mm_cvtsi32_si128(k as i32);
+            YU(self.0.map(|v| _mm256_sll_epi64(v, k)))
+        }
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; WIDTH]) {
+        let v = self.0;
+        unsafe {
+            // Below 2³¹, so the low 32 bits as i32 are the value.
+            let (lo, hi) = (low_halves(v[0], v[1]), low_halves(v[2], v[3]));
+            _mm256_storeu_ps(a.as_mut_ptr(), _mm256_cvtepi32_ps(lo));
+            _mm256_storeu_ps(a.as_mut_ptr().add(8), _mm256_cvtepi32_ps(hi));
         }
     }
 }

@@ -3,7 +3,7 @@
 #![cfg(target_arch = "x86_64")]
 
 use super::avx2::Y;
-use super::{Kernel, Lanes, Vector, Vector64, WIDTH};
+use super::{Kernel, Lanes, Vector, Vector64, VectorU64, WIDTH};
 use std::arch::x86_64::*;
 
 #[derive(Clone, Copy)]
@@ -23,6 +23,7 @@ impl Lanes for Avx512 {
     type V = Z;
     type W = Y;
     type D = ZD;
+    type U = ZU;
 }
 
 #[derive(Clone, Copy)]
@@ -255,6 +256,88 @@ impl Vector64<WIDTH> for ZD {
                 _mm512_mask_blend_pd(m as __mmask8, b.0, a.0),
                 _mm512_mask_blend_pd((m >> 8) as __mmask8, b.1, a.1),
             )
+        }
+    }
+}
+
+/// 16 u64 lanes in two zmm registers (lanes 0–7, 8–15).
+#[derive(Clone, Copy)]
+pub struct ZU(__m512i, __m512i);
+
+macro_rules! opu {
+    ($name:ident, $f:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self) -> Self {
+            unsafe { ZU($f(self.0, o.0), $f(self.1, o.1)) }
+        }
+    };
+}
+
+/// The low 64 bits of a·b per lane from 32-bit products (avx512f has no 64-bit multiply; that
+/// is avx512dq): lo·lo + (hi·lo + lo·hi)·2³².
+#[inline(always)]
+fn mullo_epi64(a: __m512i, b: __m512i) -> __m512i {
+    unsafe {
+        let lo = _mm512_mul_epu32(a, b);
+        let cross = _mm512_add_epi64(
+            _mm512_mul_epu32(_mm512_srli_epi64::<32>(a), b),
+            _mm512_mul_epu32(a, _mm512_srli_epi64::<32>(b)),
+        );
+        _mm512_add_epi64(lo, _mm512_slli_epi64::<32>(cross))
+    }
+}
+
+impl VectorU64<WIDTH> for ZU {
+    #[inline(always)]
+    fn splat(x: u64) -> Self {
+        unsafe { ZU(_mm512_set1_epi64(x as i64), _mm512_set1_epi64(x as i64)) }
+    }
+    #[inline(always)]
+    fn load(a: &[u64; WIDTH]) -> Self {
+        unsafe {
+            let p = a.as_ptr() as *const __m512i;
+            ZU(_mm512_loadu_si512(p), _mm512_loadu_si512(p.add(1)))
+        }
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [u64; WIDTH]) {
+        unsafe {
+            let p = a.as_mut_ptr() as *mut __m512i;
+            _mm512_storeu_si512(p, self.0);
+            _mm512_storeu_si512(p.add(1), self.1);
+        }
+    }
+    opu!(add, _mm512_add_epi64);
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        ZU(mullo_epi64(self.0, o.0), mullo_epi64(self.1, o.1))
+    }
+    opu!(xor, _mm512_xor_si512);
+    opu!(or, _mm512_or_si512);
+    opu!(and, _mm512_and_si512);
+    opu!(shr_lanes, _mm512_srlv_epi64);
+    #[inline(always)]
+    fn shr(self, k: u32) -> Self {
+        unsafe {
+            let k = _mm_cvtsi32_si128(k as i32);
+            ZU(_mm512_srl_epi64(self.0, k), _mm512_srl_epi64(self.1, k))
+        }
+    }
+    #[inline(always)]
+    fn shl(self, k: u32) -> Self {
+        unsafe {
+            let k = _mm_cvtsi32_si128(k as i32);
+            ZU(_mm512_sll_epi64(self.0, k), _mm512_sll_epi64(self.1, k))
+        }
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; WIDTH]) {
+        unsafe {
+            // Below 2³¹, so the low 32 bits as i32 are the value.
+            let lo = _mm512_cvtepi64_epi32(self.0);
+            let hi = _mm512_cvtepi64_epi32(self.1);
+            let both = _mm512_inserti64x4::<1>(_mm512_castsi256_si512(lo), hi);
+            _mm512_storeu_ps(a.as_mut_ptr(), _mm512_cvtepi32_ps(both));
         }
     }
 }

@@ -95,6 +95,31 @@ pub trait Vector64<const N: usize>: Copy {
     fn select(m: u32, a: Self, b: Self) -> Self;
 }
 
+/// A u64 vector of `N` lanes with wrapping arithmetic, for the random streams' 64-bit state
+/// (PCG32 and splitmix64 over a packet's lanes, #19 item 8): integer operations only, so every
+/// ISA gives the same bits. (LLVM vectorised plain u64 arrays only in part: it ran the PCG
+/// output's shifts and rotate lane by lane as scalar code.)
+pub trait VectorU64<const N: usize>: Copy {
+    fn splat(x: u64) -> Self;
+    fn load(a: &[u64; N]) -> Self;
+    fn store(self, a: &mut [u64; N]);
+    /// `wrapping_add` per lane.
+    fn add(self, o: Self) -> Self;
+    /// `wrapping_mul` per lane: the low 64 bits of the product.
+    fn mul(self, o: Self) -> Self;
+    fn xor(self, o: Self) -> Self;
+    fn or(self, o: Self) -> Self;
+    fn and(self, o: Self) -> Self;
+    /// Every lane shifted right by `k` < 64.
+    fn shr(self, k: u32) -> Self;
+    /// Every lane shifted left by `k` < 64.
+    fn shl(self, k: u32) -> Self;
+    /// Each lane shifted right by the same lane of `k` (each < 64).
+    fn shr_lanes(self, k: Self) -> Self;
+    /// Each lane, which must be below 2³¹, rounded to the nearest f32 (`as f32`).
+    fn to_f32(self, a: &mut [f32; N]);
+}
+
 /// One ISA's vector types. A zero-sized type, so a kernel names its ISA once.
 pub trait Lanes: Copy {
     /// 16 lanes: a packet.
@@ -105,6 +130,9 @@ pub trait Lanes: Copy {
     /// path. (Portable arrays on every ISA vectorised only in part in a kernel as large as the
     /// spherical rectangle's, with scalar `sd` instructions and spills: docs/tracer.md.)
     type D: Vector64<WIDTH>;
+    /// 16 u64 lanes: two zmm registers on AVX-512, four ymm on AVX2, an array on the portable
+    /// path.
+    type U: VectorU64<WIDTH>;
 }
 
 /// A computation generic over the lane types; [`run`] instantiates it for one ISA. Mark `run`
@@ -262,5 +290,94 @@ mod tests {
                 assert_eq!(run(isa, Step(&xs, up)), want, "{isa:?} up={up:#x}");
             }
         }
+    }
+
+    /// Every u64 lane operation of `a` and `b` (shift counts from `b`'s low six bits).
+    struct ProbeU64<'a>(&'a [u64; WIDTH], &'a [u64; WIDTH]);
+
+    impl Kernel for ProbeU64<'_> {
+        type Out = (Vec<[u64; WIDTH]>, [u32; WIDTH]);
+        fn run<L: Lanes>(self) -> Self::Out {
+            let (x, y) = (L::U::load(self.0), L::U::load(self.1));
+            let k = y.and(L::U::splat(63));
+            let vs = [
+                x.add(y),
+                x.mul(y),
+                x.xor(y),
+                x.or(y),
+                x.and(y),
+                x.shr(0),
+                x.shr(1),
+                x.shr(33),
+                x.shr(63),
+                x.shl(0),
+                x.shl(31),
+                x.shl(63),
+                x.shr_lanes(k),
+                L::U::splat(self.0[3]),
+            ];
+            let out = vs
+                .iter()
+                .map(|v| {
+                    let mut o = [0; WIDTH];
+                    v.store(&mut o);
+                    o
+                })
+                .collect();
+            // Below 2^31: 0, 1, 2^24 + 1 (rounds to even), 2^31 − 1 (rounds up), …
+            let mut f = [0.0f32; WIDTH];
+            x.shr(33).to_f32(&mut f);
+            (out, f.map(f32::to_bits))
+        }
+    }
+
+    /// The u64 lanes are u64 arithmetic on every ISA (products whose cross terms carry, shifts
+    /// by 0 and 63, each lane by its own count), and their f32 conversion is `as f32`.
+    #[test]
+    fn u64_lanes_are_wrapping_u64_arithmetic() {
+        let mut checked = 0;
+        for round in 0..64u64 {
+            let a: [u64; WIDTH] = std::array::from_fn(|i| match (i as u64 + round) % 8 {
+                0 => u64::MAX,
+                1 => 0,
+                2 => 0xffff_ffff,
+                3 => ((1u64 << 24) + 1) << 33,
+                4 => ((1u64 << 31) - 1) << 33,
+                _ => crate::math::mix64(round * 16 + i as u64),
+            });
+            let b: [u64; WIDTH] = std::array::from_fn(|i| match (i as u64 + 3 * round) % 5 {
+                0 => u64::MAX,
+                1 => 1 << 32,
+                _ => crate::math::mix64(!(round * 16 + i as u64)),
+            });
+            let scalar =
+                |f: fn(u64, u64) -> u64| -> [u64; WIDTH] { std::array::from_fn(|i| f(a[i], b[i])) };
+            let want = [
+                scalar(u64::wrapping_add),
+                scalar(u64::wrapping_mul),
+                scalar(|a, b| a ^ b),
+                scalar(|a, b| a | b),
+                scalar(|a, b| a & b),
+                scalar(|a, _| a),
+                scalar(|a, _| a >> 1),
+                scalar(|a, _| a >> 33),
+                scalar(|a, _| a >> 63),
+                scalar(|a, _| a),
+                scalar(|a, _| a << 31),
+                scalar(|a, _| a << 63),
+                scalar(|a, b| a >> (b & 63)),
+                [a[3]; WIDTH],
+            ];
+            let want_f = a.map(|a| ((a >> 33) as f32).to_bits());
+            for isa in Isa::ALL {
+                let (got, got_f) = run(isa, ProbeU64(&a, &b));
+                for (op, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert_eq!(g, w, "{isa:?} operation {op}, round {round}");
+                }
+                assert_eq!(got_f, want_f, "{isa:?} to_f32, round {round}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 64, "{checked}");
     }
 }

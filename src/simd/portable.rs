@@ -1,6 +1,6 @@
 //! The portable path: plain arrays, scalar code with the same semantics as the SIMD paths.
 
-use super::{Lanes, NARROW, Vector, Vector64, WIDTH};
+use super::{Lanes, NARROW, Vector, Vector64, VectorU64, WIDTH};
 
 #[derive(Clone, Copy)]
 pub struct Portable;
@@ -9,6 +9,132 @@ impl Lanes for Portable {
     type V = P<WIDTH>;
     type W = P<NARROW>;
     type D = PD<WIDTH>;
+    type U = PU<WIDTH>;
+}
+
+/// u64 lanes as a plain array: the portable path's [`Lanes::U`].
+#[derive(Clone, Copy)]
+pub struct PU<const N: usize>([u64; N]);
+
+impl<const N: usize> PU<N> {
+    #[inline(always)]
+    fn map(self, f: impl Fn(u64) -> u64) -> Self {
+        PU(self.0.map(f))
+    }
+
+    #[inline(always)]
+    fn map2(self, o: Self, f: impl Fn(u64, u64) -> u64) -> Self {
+        let mut r = [0; N];
+        for (r, (a, b)) in r.iter_mut().zip(self.0.iter().zip(o.0.iter())) {
+            *r = f(*a, *b);
+        }
+        PU(r)
+    }
+}
+
+impl<const N: usize> VectorU64<N> for PU<N> {
+    #[inline(always)]
+    fn splat(x: u64) -> Self {
+        PU([x; N])
+    }
+    #[inline(always)]
+    fn load(a: &[u64; N]) -> Self {
+        PU(*a)
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [u64; N]) {
+        *a = self.0;
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.map2(o, u64::wrapping_add)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.map2(o, u64::wrapping_mul)
+    }
+    #[inline(always)]
+    fn xor(self, o: Self) -> Self {
+        self.map2(o, |a, b| a ^ b)
+    }
+    #[inline(always)]
+    fn or(self, o: Self) -> Self {
+        self.map2(o, |a, b| a | b)
+    }
+    #[inline(always)]
+    fn and(self, o: Self) -> Self {
+        self.map2(o, |a, b| a & b)
+    }
+    #[inline(always)]
+    fn shr(self, k: u32) -> Self {
+        self.map(|a| a >> k)
+    }
+    #[inline(always)]
+    fn shl(self, k: u32) -> Self {
+        self.map(|a| a << k)
+    }
+    #[inline(always)]
+    fn shr_lanes(self, k: Self) -> Self {
+        self.map2(k, |a, k| a >> k)
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; N]) {
+        for (a, x) in a.iter_mut().zip(self.0) {
+            *a = x as f32;
+        }
+    }
+}
+
+/// One u64 is one lane: scalar code calls the code written over lanes with it.
+impl VectorU64<1> for u64 {
+    #[inline(always)]
+    fn splat(x: u64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn load(a: &[u64; 1]) -> Self {
+        a[0]
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [u64; 1]) {
+        a[0] = self;
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self.wrapping_add(o)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        self.wrapping_mul(o)
+    }
+    #[inline(always)]
+    fn xor(self, o: Self) -> Self {
+        self ^ o
+    }
+    #[inline(always)]
+    fn or(self, o: Self) -> Self {
+        self | o
+    }
+    #[inline(always)]
+    fn and(self, o: Self) -> Self {
+        self & o
+    }
+    #[inline(always)]
+    fn shr(self, k: u32) -> Self {
+        self >> k
+    }
+    #[inline(always)]
+    fn shl(self, k: u32) -> Self {
+        self << k
+    }
+    #[inline(always)]
+    fn shr_lanes(self, k: Self) -> Self {
+        self >> k
+    }
+    #[inline(always)]
+    fn to_f32(self, a: &mut [f32; 1]) {
+        a[0] = self as f32;
+    }
 }
 
 /// f64 lanes as a plain array: the portable path's [`Lanes::D`] (see there).

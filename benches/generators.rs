@@ -1,0 +1,47 @@
+//! Cost of a packet's sample numbers: `SampleGenerator::fill_lanes` of 16 lanes at the
+//! dimensions `mis-power` reads (2 camera + 1 selection + 3 light + 3 BSDF = 9), per generator.
+//! The random streams are part of every sample's cost (#19 item 8).
+
+use criterion::{Criterion, black_box, criterion_group, criterion_main};
+use dibench::sampling::GENERATORS;
+use dibench::sampling::generator::MAX_DIMENSIONS;
+use dibench::sampling::{Dimension, Layout, SampleKey, Setup};
+use dibench::simd::WIDTH;
+
+fn fill_lanes(c: &mut Criterion) {
+    let layout = Layout::of(&[
+        Dimension::one("selection"),
+        Dimension::pair("light"),
+        Dimension::one("light low bits"),
+        Dimension::pair("bsdf"),
+        Dimension::one("lobe"),
+    ]);
+    let (w, h) = (256u32, 256u32);
+    let setup = Setup::image(layout, Some(1024), w, h);
+    let dims = setup.layout.len();
+    let mut group = c.benchmark_group("fill_lanes");
+    for g in GENERATORS.iter() {
+        let mut pass = 0u64;
+        let mut out = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+        // 64 packets of 16 pixels per iteration: 1,024 samples.
+        group.bench_function(g.name(), |b| {
+            b.iter(|| {
+                pass = (pass + 1) % 1024;
+                for packet in 0..64u64 {
+                    let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
+                        seed: 1,
+                        strategy: 0x5eed,
+                        pixel: packet * WIDTH as u64 + i as u64,
+                        index: pass,
+                    });
+                    g.fill_lanes(&setup, &keys, 0xffff, dims, &mut out);
+                    black_box(&out);
+                }
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, fill_lanes);
+criterion_main!(benches);
