@@ -23,7 +23,12 @@ fn setup() -> tempfile::TempDir {
 }
 
 fn run(dir: &Path, args: &[&str]) -> Outcome {
-    let o = dibench_bounded(args, dir, PATIENCE);
+    run_within(dir, args, PATIENCE)
+}
+
+/// [`run`] with its own patience before the interrupt.
+fn run_within(dir: &Path, args: &[&str], patience: Duration) -> Outcome {
+    let o = dibench_bounded(args, dir, patience);
     assert!(o.ended_cleanly(), "{args:?}: {o:?}");
     assert!(
         temps_under(dir).is_empty(),
@@ -620,10 +625,12 @@ fn environment_maps_every_way_broken() {
             &["environment.file", says],
         );
     }
-    // The good map works.
-    let o = run(
+    // The good map works. Given time: this checks that it is accepted, not how fast it loads
+    // (it once took over 1.5 s on CI's two shared cores, in the Embree build).
+    let o = run_within(
         d,
         &["strategies", &scene_with(d, "env.toml", &env("good.exr"))],
+        Duration::from_secs(30),
     );
     assert_eq!(o.code, Some(0), "{}", o.stderr);
 }
