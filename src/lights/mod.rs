@@ -453,6 +453,18 @@ impl SurfaceLanes {
     }
 }
 
+/// The lanes (bit i = lane i) whose entry in `values` is `v`: which lanes chose one light.
+#[inline]
+pub fn lanes_holding<T: PartialEq>(values: &[T; WIDTH], v: T) -> u32 {
+    let mut mask = 0;
+    for (lane, x) in values.iter().enumerate() {
+        if *x == v {
+            mask |= 1 << lane;
+        }
+    }
+    mask
+}
+
 /// [`Light::pdf_lanes`] lane by lane: the scalar [`Light::pdf`] of each lane of `active`.
 pub fn pdf_lane_by_lane<T: Light + ?Sized>(
     light: &T,
@@ -770,13 +782,7 @@ impl LightSet {
         let mut rest = active;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
-            let mut mask = 0;
-            for (lane, &l) in light.iter().enumerate() {
-                if l == i {
-                    mask |= 1 << lane;
-                }
-            }
-            mask &= active;
+            let mask = lanes_holding(light, i) & active;
             rest &= !mask;
             self.lights[i as usize].pdf_lanes(isa, at, mask, m, &mut pdf);
         }

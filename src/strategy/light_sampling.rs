@@ -12,6 +12,7 @@ use crate::lights::{
 };
 use crate::lights::{
     LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride, SurfaceLanes,
+    lanes_holding,
 };
 use crate::math::offset_ray_origin_lanes;
 use crate::prepare::SceneView;
@@ -289,12 +290,7 @@ impl<'s> BoundLights<'s> {
         let mut rest = chosen & !with_kernel;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
-            let mut mask = 0;
-            for (lane, &l) in light.iter().enumerate() {
-                if l == i {
-                    mask |= 1 << lane;
-                }
-            }
+            let mask = lanes_holding(&light, i);
             rest &= !mask;
             self.lights
                 .get(i)
