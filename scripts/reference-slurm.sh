@@ -28,7 +28,8 @@ seed=${3:-1}
 : "${SLURM_ARRAY_TASK_COUNT:?run as a job array (sbatch --array=...)}"
 shards=${DIBENCH_SHARDS:-$SLURM_ARRAY_TASK_COUNT}
 cd "${SLURM_SUBMIT_DIR:-$(dirname "$0")/..}"
-# Build once beforehand (cargo build --release) so tasks do not race on target/.
-exec ./target/release/dibench reference "$scene" --spp "$spp" --seed "$seed" \
+# Build once beforehand (cargo build --release) so tasks do not race on target/; DIBENCH_BIN
+# names another binary (with --export=ALL,DIBENCH_BIN=...).
+exec "${DIBENCH_BIN:-./target/release/dibench}" reference "$scene" --spp "$spp" --seed "$seed" \
   --shard "${SLURM_ARRAY_TASK_ID}/${shards}" \
   ${SLURM_CPUS_PER_TASK:+--threads "$SLURM_CPUS_PER_TASK"} --out "${DIBENCH_OUT:-results}"

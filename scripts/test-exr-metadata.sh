@@ -5,9 +5,10 @@
 # used. The exr crate's reading is tested in src/output/exr.rs and tests/harness_cli.rs.
 #
 #   scripts/test-exr-metadata.sh     # after cargo build --release
+#   (DIBENCH_TARGET=target/test-release to test another profile's build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bin=target/release/dibench
+bin=${DIBENCH_TARGET:-target/release}/dibench
 [ -x "$bin" ] || { echo "test-exr-metadata: $bin not found; run cargo build --release first" >&2; exit 1; }
 command -v oiiotool >/dev/null || {
   echo "test-exr-metadata: oiiotool not found; scripts/install-test-tools.sh installs it (openimageio-tools)" >&2

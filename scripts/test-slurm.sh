@@ -9,7 +9,8 @@
 # as children of this script (no systemd), on ports of their own, and are stopped, and the
 # directory removed, on any exit. Needs root (or a user that may run the daemons), the
 # binaries from scripts/install-slurm.sh, python3, and target/release/dibench (built first;
-# this script builds nothing). Then:
+# this script builds nothing; DIBENCH_TARGET names another build directory, which the jobs
+# get as DIBENCH_BIN). Then:
 #   1. a 4-task array of reference-slurm.sh plus an afterok `dibench merge` job: the merged
 #      reference must match a single-process `dibench reference` of the same spp and seed up
 #      to f32 roundoff (the equality shard.rs promises), and its shards must be bit for bit
@@ -49,7 +50,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   die "missing ${missing[*]}: run scripts/install-slurm.sh first (apt-get install slurmctld slurmd slurm-client munge; .ci/run installs them that way)"
 fi
 [ "$(id -u)" -eq 0 ] || die "must run as root: slurmctld here runs as SlurmUser=root"
-bin=$repo/target/release/dibench
+bin=$repo/${DIBENCH_TARGET:-target/release}/dibench
+export DIBENCH_BIN=$bin
 [ -x "$bin" ] || die "$bin not found: build it first (cargo build --release); this test builds nothing"
 
 # A job or shell of an outer Slurm must not leak into this cluster.
