@@ -9,13 +9,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 target=${DIBENCH_TARGET:-target/release}
+case $target in /*) ;; *) target=$PWD/$target ;; esac
 fail() {
     echo "test-browser: $*" >&2
     exit 1
 }
-[ -x "$target/dibench" ] || fail "$target/dibench is missing: cargo build --release"
+[ -x "$target/dibench" ] || fail "$target/dibench is missing: build it (cargo build --release for target/release)"
 [ -x "$target/examples/exr_pixel" ] ||
-    fail "$target/examples/exr_pixel is missing: cargo build --release --example exr_pixel"
+    fail "$target/examples/exr_pixel is missing: build it (cargo build --release --example exr_pixel for target/release)"
 command -v node >/dev/null || fail "node is not installed (node 18 or later is needed)"
 command -v npm >/dev/null || fail "npm is not installed"
 [ -x "${CHROMIUM:-/usr/bin/chromium}" ] ||
@@ -34,7 +35,7 @@ run_dir=$(find "$out/cornell" -mindepth 1 -maxdepth 1 -type d ! -name reference 
 # compare writes report.html itself (with the FLIP maps it computed).
 [ -s "$run_dir/report.html" ] || fail "compare wrote no $run_dir/report.html"
 (cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
-EXR_PIXEL="$PWD/$target/examples/exr_pixel" node tests/browser/report.test.mjs "$run_dir"
+EXR_PIXEL="$target/examples/exr_pixel" node tests/browser/report.test.mjs "$run_dir"
 # A second run with a non-independent sampler too: images named <strategy>.<sampler>, some
 # without a variance map (no screenshots from this one).
 "$target/dibench" compare cornell --time 0.1 --runs 2 --reference-spp 64 --out "$out" \
@@ -45,6 +46,6 @@ run_dir2=$(find "$out/cornell" -mindepth 1 -maxdepth 1 -type d ! -name reference
 # The subcommand writes the same page anew.
 rm "$run_dir2/report.html"
 "$target/dibench" report "$run_dir2"
-SCREENSHOTS=none EXR_PIXEL="$PWD/$target/examples/exr_pixel" \
+SCREENSHOTS=none EXR_PIXEL="$target/examples/exr_pixel" \
     node tests/browser/report.test.mjs "$run_dir2"
 echo "test-browser: passed in $(($(date +%s) - start)) s"

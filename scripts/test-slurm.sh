@@ -50,7 +50,9 @@ if [ ${#missing[@]} -gt 0 ]; then
   die "missing ${missing[*]}: run scripts/install-slurm.sh first (apt-get install slurmctld slurmd slurm-client munge; .ci/run installs them that way)"
 fi
 [ "$(id -u)" -eq 0 ] || die "must run as root: slurmctld here runs as SlurmUser=root"
-bin=$repo/${DIBENCH_TARGET:-target/release}/dibench
+target=${DIBENCH_TARGET:-target/release}
+case $target in /*) ;; *) target=$repo/$target ;; esac
+bin=$target/dibench
 export DIBENCH_BIN=$bin
 [ -x "$bin" ] || die "$bin not found: build it first (cargo build --release); this test builds nothing"
 

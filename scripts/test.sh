@@ -11,7 +11,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # The suite in the `test-release` profile (release without fat LTO: see Cargo.toml); the system
 # tests then drive that profile's binary (DIBENCH_TARGET): the same code as the binary a user
-# runs, built without the 6-minute fat-LTO link that CI's 2 cores cannot afford twice.
+# runs, without a second, fat-LTO build of it (6 min of CI's 2 cores).
 cargo test --profile test-release
 cargo build --profile test-release --bins --example exr_pixel
 export DIBENCH_TARGET=target/test-release
