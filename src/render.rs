@@ -7,7 +7,7 @@
 //! `begin_pass` with all shading points, then every tile's shading phase.
 
 use crate::error::{Error, Result};
-use crate::film::{Film, TileLayout, accumulate};
+use crate::film::{Accumulation, Film, TileLayout};
 use crate::geometry::Ray;
 use crate::geometry::triangle::Triangle;
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
@@ -141,7 +141,7 @@ impl<'a> Renderer<'a> {
     /// next pass: shard i of n renders passes i, i + n, … (see `harness::shard`), and the
     /// merged film equals a sequential render's up to roundoff.
     pub fn add_pass_with_stream(&mut self, film: &mut Film, stream: u64) {
-        let count = film.spp;
+        let update = Accumulation::of_count(film.spp);
         let layout = film.layout;
         if self.estimator.wants_pass_points() {
             let tiles: Vec<CameraTile> = (0..layout.tile_count())
@@ -173,7 +173,7 @@ impl<'a> Renderer<'a> {
                 .for_each(|((sum, m2), tile)| {
                     let radiance = this.shading_phase(tile);
                     for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
-                        accumulate(s, m, count, [l.x as f64, l.y as f64, l.z as f64]);
+                        update.add(s, m, [l.x as f64, l.y as f64, l.z as f64]);
                     }
                 });
         } else {
@@ -186,7 +186,7 @@ impl<'a> Renderer<'a> {
                     this.camera_phase(&layout, t, stream, tile);
                     let radiance = this.shading_phase(tile);
                     for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
-                        accumulate(s, m, count, [l.x as f64, l.y as f64, l.z as f64]);
+                        update.add(s, m, [l.x as f64, l.y as f64, l.z as f64]);
                     }
                 });
         }
