@@ -5,17 +5,12 @@
 use criterion::{Criterion, black_box, criterion_group, criterion_main};
 use dibench::sampling::GENERATORS;
 use dibench::sampling::generator::MAX_DIMENSIONS;
-use dibench::sampling::{Dimension, Layout, SampleKey, Setup};
+use dibench::sampling::{Layout, SampleKey, Setup};
 use dibench::simd::WIDTH;
+use dibench::strategy::{direction::BSDF_DIMS, light_sampling::LIGHT_DIMS};
 
 fn fill_lanes(c: &mut Criterion) {
-    let layout = Layout::of(&[
-        Dimension::one("selection"),
-        Dimension::pair("light"),
-        Dimension::one("light low bits"),
-        Dimension::pair("bsdf"),
-        Dimension::one("lobe"),
-    ]);
+    let layout = Layout::of(&LIGHT_DIMS).then(Layout::of(&BSDF_DIMS));
     let (w, h) = (256u32, 256u32);
     let setup = Setup::image(layout, Some(1024), w, h);
     let dims = setup.layout.len();
