@@ -8,7 +8,8 @@
 //! of the pair is a (0,m,2)-net in base 2; across groups the index is shuffled with a different
 //! seed, so no two groups are correlated.
 
-use crate::math::mix64;
+use crate::math::mix64_lanes;
+use crate::simd::VectorU64;
 
 /// Sobol dimension 0 of point `i`, as a 32-bit binary fraction: the van der Corput sequence.
 pub fn sobol_0(i: u32) -> u32 {
@@ -16,56 +17,31 @@ pub fn sobol_0(i: u32) -> u32 {
 }
 
 /// Sobol dimension 1 of point `i`, as a 32-bit binary fraction. Its generator matrix is the
-/// Pascal matrix mod 2: column k is v_k with v_0 = 1/2 and v_{k+1} = v_k ⊕ (v_k >> 1). The map
-/// is linear over GF(2), so it is four lookups, one per byte of `i`, in tables built at compile
-/// time (4 KiB) — no data-dependent branch per bit.
+/// Pascal matrix mod 2: column k is v_k with v_0 = 1/2 and v_{k+1} = v_k ⊕ (v_k >> 1).
 pub fn sobol_1(i: u32) -> u32 {
-    let t = &SOBOL_1_BYTES;
-    t[0][(i & 0xff) as usize]
-        ^ t[1][((i >> 8) & 0xff) as usize]
-        ^ t[2][((i >> 16) & 0xff) as usize]
-        ^ t[3][(i >> 24) as usize]
+    (sobol_1_reversed_lanes::<u64, 1>(i as u64) as u32).reverse_bits()
 }
 
-/// The generator matrix's 32 columns.
-const fn sobol_1_columns() -> [u32; 32] {
-    let mut v = [0u32; 32];
-    let mut c = 1u32 << 31;
-    let mut k = 0;
-    while k < 32 {
-        v[k] = c;
-        c ^= c >> 1;
-        k += 1;
+/// [`sobol_1`] of every lane (each below 2³²), bit-reversed (digit j from the top at bit j),
+/// which is what a scramble wants. Digit j is the parity of the index bits k whose positions
+/// contain j's (C(k, j) is odd iff j ⊆ k, by Lucas's theorem): a superset-sum transform over
+/// the five bits of the position, five shift-mask-xor steps with no table and no branch.
+#[inline(always)]
+pub fn sobol_1_reversed_lanes<U: VectorU64<N>, const N: usize>(i: U) -> U {
+    // (Named functions, not closures, here and below: a closure is not `inline(always)`, and
+    // a lane intrinsic left in one is a call, not an instruction.)
+    #[inline(always)]
+    fn step<U: VectorU64<N>, const N: usize>(z: U, k: u32, m: u64) -> U {
+        z.xor(z.shr(k).and(U::splat(m)))
     }
-    v
+    let z = step(i, 1, 0x5555_5555);
+    let z = step(z, 2, 0x3333_3333);
+    let z = step(z, 4, 0x0f0f_0f0f);
+    let z = step(z, 8, 0x00ff_00ff);
+    step(z, 16, 0x0000_ffff)
 }
 
-static SOBOL_1_BYTES: [[u32; 256]; 4] = sobol_1_tables();
-
-const fn sobol_1_tables() -> [[u32; 256]; 4] {
-    let v = sobol_1_columns();
-    let mut t = [[0u32; 256]; 4];
-    let mut byte = 0;
-    while byte < 4 {
-        let mut b = 0;
-        while b < 256 {
-            let mut x = 0u32;
-            let mut bit = 0;
-            while bit < 8 {
-                if b & (1 << bit) != 0 {
-                    x ^= v[byte * 8 + bit];
-                }
-                bit += 1;
-            }
-            t[byte][b] = x;
-            b += 1;
-        }
-        byte += 1;
-    }
-    t
-}
-
-/// [`sobol_1`] bit by bit, the definition the tables are checked against.
+/// [`sobol_1`] bit by bit, the definition the transform is checked against.
 pub fn sobol_1_reference(mut i: u32) -> u32 {
     let mut v = 1u32 << 31;
     let mut x = 0;
@@ -79,32 +55,48 @@ pub fn sobol_1_reference(mut i: u32) -> u32 {
     x
 }
 
+/// The low 32 bits of every lane reversed; each lane must be below 2³² (`u32::reverse_bits`).
+#[inline(always)]
+pub fn reverse32_lanes<U: VectorU64<N>, const N: usize>(x: U) -> U {
+    #[inline(always)]
+    fn swap<U: VectorU64<N>, const N: usize>(x: U, k: u32, m: u64) -> U {
+        let m = U::splat(m);
+        x.shr(k).and(m).or(x.and(m).shl(k))
+    }
+    let x = x.shr(16).or(x.shl(16)).and(U::splat(0xffff_ffff));
+    let x = swap(x, 8, 0x00ff_00ff);
+    let x = swap(x, 4, 0x0f0f_0f0f);
+    let x = swap(x, 2, 0x3333_3333);
+    swap(x, 1, 0x5555_5555)
+}
+
 /// A bijection of 32-bit words in which output bit p is input bit p flipped by a function of
 /// the input bits below p (and of `seed`): each step is such a map — adding a constant (the
 /// carry comes from below), xor with the word times an even constant (its bit p depends on
 /// bits below p), multiplying by an odd constant — and so is their composition. Applied to a
 /// bit-reversed fraction it is a nested uniform scramble: digit k is flipped by a hash of the
 /// digits before it (Laine & Karras 2011; Burley 2020). Four 32-bit words of a hash of the
-/// seed enter as additive and multiplicative constants.
-fn lower_triangular_hash(mut x: u32, seed: u64) -> u32 {
+/// seed enter as additive and multiplicative constants. Over u64 lanes holding 32-bit words;
+/// the result is below 2³².
+#[inline(always)]
+fn lower_triangular_hash_lanes<U: VectorU64<N>, const N: usize>(x: U, seed: U) -> U {
     // One 64-bit hash of the seed gives the four constants (the second pair by a multiply,
     // which keeps them well mixed at the cost of one instruction instead of another hash).
-    let s = mix64(seed);
-    let t = s.wrapping_mul(0xD1B5_4A32_D192_ED03);
-    let (a, b, c, d) = (
-        s as u32,
-        (s >> 32) as u32,
-        (t >> 32) as u32,
-        t as u32 ^ (s >> 17) as u32,
-    );
-    x = x.wrapping_add(a);
-    x ^= x.wrapping_mul(0x6d2b_79f4);
-    x = x.wrapping_mul(b | 1);
-    x ^= x.wrapping_mul(c & !1);
-    x = x.wrapping_add(d);
-    x ^= x.wrapping_mul(0xa3b1_95c8);
-    x ^= x.wrapping_mul(0x3c6e_f372 & !1);
-    x
+    let s = mix64_lanes(seed);
+    let t = s.mul(U::splat(0xD1B5_4A32_D192_ED03));
+    let b = s.shr(32).or(U::splat(1));
+    let c = t.shr(32).and(U::splat(!1));
+    let d = t.xor(s.shr(17));
+    // The low 32 bits of a sum, a xor and a `mul32` depend on the operands' low 32 bits
+    // alone, so the words need one mask, at the end.
+    let x = x.add(s);
+    let x = x.xor(x.mul32(U::splat(0x6d2b_79f4)));
+    let x = x.mul32(b);
+    let x = x.xor(x.mul32(c));
+    let x = x.add(d);
+    let x = x.xor(x.mul32(U::splat(0xa3b1_95c8)));
+    let x = x.xor(x.mul32(U::splat(0x3c6e_f372 & !1)));
+    x.and(U::splat(0xffff_ffff))
 }
 
 /// Owen scramble of the 32-bit binary fraction `x` with `seed`: the binary digit at depth k
@@ -113,12 +105,30 @@ fn lower_triangular_hash(mut x: u32, seed: u64) -> u32 {
 /// indices onto an aligned block of 2^m indices (the bits from m up depend only on bits from
 /// m up), so a prefix of 2^m points of a (0,2)-sequence stays a (0,m,2)-net.
 pub fn owen(x: u32, seed: u64) -> u32 {
-    lower_triangular_hash(x.reverse_bits(), seed).reverse_bits()
+    owen_lanes::<u64, 1>(x as u64, seed) as u32
+}
+
+/// [`owen`] of every lane (each below 2³²), with each lane's seed.
+#[inline(always)]
+pub fn owen_lanes<U: VectorU64<N>, const N: usize>(x: U, seed: U) -> U {
+    reverse32_lanes(lower_triangular_hash_lanes(reverse32_lanes(x), seed))
 }
 
 /// A 32-bit fraction as an f32 in [0, 1): its top 24 bits, exactly representable.
 pub fn to_unit(x: u32) -> f32 {
-    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+    (x >> 8) as f32 * UNIT
+}
+
+/// 2^-24: one step of [`to_unit`]'s 24-bit grid.
+const UNIT: f32 = 1.0 / 16_777_216.0;
+
+/// [`to_unit`] of every lane (each below 2³²), into `out`.
+#[inline(always)]
+pub fn to_unit_lanes<U: VectorU64<N>, const N: usize>(x: U, out: &mut [f32; N]) {
+    x.shr(8).to_f32(out);
+    for o in out.iter_mut() {
+        *o *= UNIT;
+    }
 }
 
 /// One randomized point of a (0,2)-sequence pair, as used by every layout group: the index `i`
@@ -134,13 +144,29 @@ pub fn scrambled_pair(i: u32, seed: u64, pair: bool) -> [f32; 2] {
 /// Sobol point `j` (dimensions 0 and 1, or 0 alone), each coordinate Owen-scrambled with a seed
 /// derived from `seed`; no index shuffle (Z-Sobol permutes its index itself).
 pub fn scrambled_point(j: u32, seed: u64, pair: bool) -> [f32; 2] {
-    let x = lower_triangular_hash(j, seed ^ 0xa5a5_0001).reverse_bits();
+    let [x, y] = scrambled_point_lanes::<u64, 1>(j as u64, seed, pair);
+    [to_unit(x as u32), to_unit(y as u32)]
+}
+
+/// [`scrambled_point`] of every lane, as 32-bit fractions (the second 0 when `pair` is false).
+/// owen(sobol_1(j)) is reverse(hash(reverse(sobol_1(j)))), and the transform gives
+/// sobol_1(j) already reversed.
+#[inline(always)]
+pub fn scrambled_point_lanes<U: VectorU64<N>, const N: usize>(j: U, seed: U, pair: bool) -> [U; 2] {
+    let x = reverse32_lanes(lower_triangular_hash_lanes(
+        j,
+        seed.xor(U::splat(0xa5a5_0001)),
+    ));
     let y = if pair {
-        owen(sobol_1(j), seed ^ 0xa5a5_0002)
+        let z = sobol_1_reversed_lanes(j);
+        reverse32_lanes(lower_triangular_hash_lanes(
+            z,
+            seed.xor(U::splat(0xa5a5_0002)),
+        ))
     } else {
-        0
+        U::splat(0)
     };
-    [to_unit(x), to_unit(y)]
+    [x, y]
 }
 
 /// Interleaves the bits of x (even positions) and y (odd positions).
@@ -203,7 +229,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tables_and_shortcuts_match_their_definitions() {
+    fn transform_and_shortcuts_match_their_definitions() {
         let mut x = 0x1234_5678u32;
         for i in (0..5000u32).chain([u32::MAX, 1 << 31, 0xdead_beef]) {
             assert_eq!(sobol_1(i), sobol_1_reference(i), "{i}");

@@ -13,9 +13,10 @@
 //! strategies or pixels never share points. Past 2^32 samples of a pixel the index wraps into
 //! a fresh randomization (an epoch in the seed).
 
-use super::generator::{SampleGenerator, SampleKey, Setup};
-use super::qmc::scrambled_pair;
-use crate::math::mix64;
+use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
+use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, to_unit_lanes};
+use crate::math::mix64_lanes;
+use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 
 pub struct Sobol;
 
@@ -23,13 +24,24 @@ pub static SOBOL: Sobol = Sobol;
 
 /// The seed every group of a sample key's sequence derives from (index epoch included).
 pub fn sequence_seed(key: &SampleKey, epoch: u64) -> u64 {
-    mix64(mix64(key.seed ^ 0x50b0_1d5e_ed00_0001) ^ key.strategy ^ mix64(key.pixel ^ (epoch << 40)))
+    sequence_seed_lanes::<u64, 1>(key.seed, key.strategy, key.pixel, epoch)
+}
+
+/// [`sequence_seed`] of every lane's key.
+#[inline(always)]
+fn sequence_seed_lanes<U: VectorU64<N>, const N: usize>(seed: U, strategy: U, pixel: U, epoch: U) -> U {
+    let run = mix64_lanes(seed.xor(U::splat(0x50b0_1d5e_ed00_0001)));
+    mix64_lanes(run.xor(strategy).xor(mix64_lanes(pixel.xor(epoch.shl(40)))))
 }
 
 /// The seed of layout group `group` of the sequence seeded `sequence` (`owen` hashes it again,
 /// so a distinct odd multiple per group suffices).
 pub fn group_seed(sequence: u64, group: usize) -> u64 {
-    sequence ^ (group as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+    sequence ^ group_key(group)
+}
+
+fn group_key(group: usize) -> u64 {
+    (group as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
 /// Fills `out` group by group from `setup.layout`: the point of index `i` (of one epoch) with
@@ -60,5 +72,120 @@ impl SampleGenerator for Sobol {
     fn fill(&self, setup: &Setup, key: SampleKey, out: &mut [f32]) {
         let sequence = sequence_seed(&key, key.index >> 32);
         fill_groups(setup, key.index as u32, |g| group_seed(sequence, g), out);
+    }
+
+    /// The packet's sixteen sequences side by side over the lane layer's u64 lanes, in the
+    /// CPU's ISA (inactive lanes are computed too; their values are unspecified): the same
+    /// numbers as [`Self::fill`] (`lanes_fill_as_single_samples`, `every_isa_fills_as_one_sample`).
+    fn fill_lanes(
+        &self,
+        setup: &Setup,
+        keys: &[SampleKey; WIDTH],
+        _lanes: Mask,
+        dims: usize,
+        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    ) {
+        crate::simd::run(Isa::best(), FillLanes::new(setup, keys, dims, out));
+    }
+}
+
+/// [`Sobol::fill_lanes`] as a lane kernel: the layout's groups that fall below `dims` (each's
+/// first dimension, and whether it is a pair there), and the keys as lanes.
+struct FillLanes<'a> {
+    groups: [(usize, bool); MAX_DIMENSIONS],
+    count: usize,
+    seed: [u64; WIDTH],
+    strategy: [u64; WIDTH],
+    pixel: [u64; WIDTH],
+    index: [u64; WIDTH],
+    out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+}
+
+impl<'a> FillLanes<'a> {
+    fn new(
+        setup: &Setup,
+        keys: &[SampleKey; WIDTH],
+        dims: usize,
+        out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    ) -> Self {
+        let dims = dims.min(MAX_DIMENSIONS);
+        let mut groups = [(0, false); MAX_DIMENSIONS];
+        let mut count = 0;
+        for (start, d) in setup.layout.offsets().take_while(|(s, _)| *s < dims) {
+            groups[count] = (start, d.width == 2 && start + 1 < dims);
+            count += 1;
+        }
+        FillLanes {
+            groups,
+            count,
+            seed: keys.map(|k| k.seed),
+            strategy: keys.map(|k| k.strategy),
+            pixel: keys.map(|k| k.pixel),
+            index: keys.map(|k| k.index),
+            out,
+        }
+    }
+}
+
+impl Kernel for FillLanes<'_> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let load = L::U::load;
+        let index = load(&self.index);
+        let sequence = sequence_seed_lanes(
+            load(&self.seed),
+            load(&self.strategy),
+            load(&self.pixel),
+            index.shr(32),
+        );
+        let i = index.and(L::U::splat(0xffff_ffff));
+        let mut unit = [0.0f32; WIDTH];
+        for (g, &(start, pair)) in self.groups[..self.count].iter().enumerate() {
+            let seed = sequence.xor(L::U::splat(group_key(g)));
+            let [x, y] = scrambled_point_lanes(owen_lanes(i, seed), seed, pair);
+            to_unit_lanes(x, &mut unit);
+            for (o, &u) in self.out.iter_mut().zip(unit.iter()) {
+                o[start] = u;
+            }
+            if pair {
+                to_unit_lanes(y, &mut unit);
+                for (o, &u) in self.out.iter_mut().zip(unit.iter()) {
+                    o[start + 1] = u;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{Dimension, Layout};
+
+    /// Every ISA's packet fill gives each lane's single-sample numbers, for keys that differ
+    /// in every field, index epochs past 2³² included (integer lanes: nothing may differ).
+    #[test]
+    fn every_isa_fills_as_one_sample() {
+        let layout = Layout::of(&[Dimension::pair("a"), Dimension::one("b"), Dimension::pair("c")]);
+        let setup = Setup::image(layout, None, 64, 64);
+        // 6 of the 7 dimensions: the last pair is cut to one.
+        let dims = 6;
+        let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
+            seed: 9 + (i as u64 % 2),
+            strategy: 0x5eed + (i as u64 % 3),
+            pixel: i as u64 * 1_000_003,
+            index: [0, 1, 7, u32::MAX as u64, 1 << 32, u64::MAX][i % 6].wrapping_sub(i as u64 / 6),
+        });
+        let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+        for (k, w) in keys.iter().zip(want.iter_mut()) {
+            SOBOL.fill(&setup, *k, &mut w[..dims]);
+        }
+        for isa in Isa::available() {
+            let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+            crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, &mut got));
+            let bits = |a: &[[f32; MAX_DIMENSIONS]; WIDTH]| a.map(|r| r[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>());
+            assert_eq!(bits(&got), bits(&want), "{isa:?}");
+        }
     }
 }

@@ -469,6 +469,7 @@ impl VectorU64<WIDTH> for YU {
             mullo_epi64(a[3], b[3]),
         ])
     }
+    opu!(mul32, _mm256_mul_epu32);
     opu!(xor, _mm256_xor_si256);
     opu!(or, _mm256_or_si256);
     opu!(and, _mm256_and_si256);

@@ -312,6 +312,7 @@ impl VectorU64<WIDTH> for ZU {
     fn mul(self, o: Self) -> Self {
         ZU(mullo_epi64(self.0, o.0), mullo_epi64(self.1, o.1))
     }
+    opu!(mul32, _mm512_mul_epu32);
     opu!(xor, _mm512_xor_si512);
     opu!(or, _mm512_or_si512);
     opu!(and, _mm512_and_si512);

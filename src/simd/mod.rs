@@ -107,6 +107,9 @@ pub trait VectorU64<const N: usize>: Copy {
     fn add(self, o: Self) -> Self;
     /// `wrapping_mul` per lane: the low 64 bits of the product.
     fn mul(self, o: Self) -> Self;
+    /// The full 64-bit product of each lane's low 32 bits (the high halves are ignored): one
+    /// `pmuludq`, for arithmetic on 32-bit words held in u64 lanes.
+    fn mul32(self, o: Self) -> Self;
     fn xor(self, o: Self) -> Self;
     fn or(self, o: Self) -> Self;
     fn and(self, o: Self) -> Self;
@@ -303,6 +306,7 @@ mod tests {
             let vs = [
                 x.add(y),
                 x.mul(y),
+                x.mul32(y),
                 x.xor(y),
                 x.or(y),
                 x.and(y),
@@ -355,6 +359,7 @@ mod tests {
             let want = [
                 scalar(u64::wrapping_add),
                 scalar(u64::wrapping_mul),
+                scalar(|a, b| (a as u32 as u64) * (b as u32 as u64)),
                 scalar(|a, b| a ^ b),
                 scalar(|a, b| a | b),
                 scalar(|a, b| a & b),

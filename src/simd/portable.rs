@@ -54,6 +54,10 @@ impl<const N: usize> VectorU64<N> for PU<N> {
         self.map2(o, u64::wrapping_mul)
     }
     #[inline(always)]
+    fn mul32(self, o: Self) -> Self {
+        self.map2(o, |a, b| (a as u32 as u64) * (b as u32 as u64))
+    }
+    #[inline(always)]
     fn xor(self, o: Self) -> Self {
         self.map2(o, |a, b| a ^ b)
     }
@@ -106,6 +110,10 @@ impl VectorU64<1> for u64 {
     #[inline(always)]
     fn mul(self, o: Self) -> Self {
         self.wrapping_mul(o)
+    }
+    #[inline(always)]
+    fn mul32(self, o: Self) -> Self {
+        (self as u32 as u64) * (o as u32 as u64)
     }
     #[inline(always)]
     fn xor(self, o: Self) -> Self {
