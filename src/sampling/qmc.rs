@@ -8,8 +8,9 @@
 //! of the pair is a (0,m,2)-net in base 2; across groups the index is shuffled with a different
 //! seed, so no two groups are correlated.
 
+use super::generator::{MAX_DIMENSIONS, Setup};
 use crate::math::mix64_lanes;
-use crate::simd::VectorU64;
+use crate::simd::{VectorU64, WIDTH};
 
 /// Sobol dimension 0 of point `i`, as a 32-bit binary fraction: the van der Corput sequence.
 pub fn sobol_0(i: u32) -> u32 {
@@ -128,6 +129,54 @@ pub fn to_unit_lanes<U: VectorU64<N>, const N: usize>(x: U, out: &mut [f32; N]) 
     x.shr(8).to_f32(out);
     for o in out.iter_mut() {
         *o *= UNIT;
+    }
+}
+
+/// The layout groups a packet fill writes: each group's first dimension below `dims`, and
+/// whether it is a pair there (both of its dimensions below `dims`).
+#[derive(Clone, Copy)]
+pub struct LaneGroups {
+    groups: [(usize, bool); MAX_DIMENSIONS],
+    count: usize,
+}
+
+impl LaneGroups {
+    pub fn of(setup: &Setup, dims: usize) -> Self {
+        let dims = dims.min(MAX_DIMENSIONS);
+        let mut groups = [(0, false); MAX_DIMENSIONS];
+        let mut count = 0;
+        for (start, d) in setup.layout.offsets().take_while(|(s, _)| *s < dims) {
+            groups[count] = (start, d.width == 2 && start + 1 < dims);
+            count += 1;
+        }
+        LaneGroups { groups, count }
+    }
+
+    /// (first dimension, pair) of each group, in layout order.
+    pub fn as_slice(&self) -> &[(usize, bool)] {
+        &self.groups[..self.count]
+    }
+}
+
+/// Writes one group's point of every lane (32-bit fractions) as numbers in [0, 1) into
+/// dimension `start` of each lane's row, and its second coordinate into `start + 1` for a pair.
+#[inline(always)]
+pub fn store_point_lanes<U: VectorU64<WIDTH>>(
+    point: [U; 2],
+    start: usize,
+    pair: bool,
+    out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+) {
+    let mut unit = [0.0f32; WIDTH];
+    to_unit_lanes(point[0], &mut unit);
+    for (o, &u) in out.iter_mut().zip(unit.iter()) {
+        o[start] = u;
+    }
+    if pair {
+        to_unit_lanes(point[1], &mut unit);
+        for (o, &u) in out.iter_mut().zip(unit.iter()) {
+            o[start + 1] = u;
+        }
     }
 }
 

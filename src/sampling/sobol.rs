@@ -14,7 +14,7 @@
 //! a fresh randomization (an epoch in the seed).
 
 use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
-use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, to_unit_lanes};
+use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, LaneGroups, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 
@@ -92,8 +92,7 @@ impl SampleGenerator for Sobol {
 /// [`Sobol::fill_lanes`] as a lane kernel: the layout's groups that fall below `dims` (each's
 /// first dimension, and whether it is a pair there), and the keys as lanes.
 struct FillLanes<'a> {
-    groups: [(usize, bool); MAX_DIMENSIONS],
-    count: usize,
+    groups: LaneGroups,
     seed: [u64; WIDTH],
     strategy: [u64; WIDTH],
     pixel: [u64; WIDTH],
@@ -108,16 +107,8 @@ impl<'a> FillLanes<'a> {
         dims: usize,
         out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
     ) -> Self {
-        let dims = dims.min(MAX_DIMENSIONS);
-        let mut groups = [(0, false); MAX_DIMENSIONS];
-        let mut count = 0;
-        for (start, d) in setup.layout.offsets().take_while(|(s, _)| *s < dims) {
-            groups[count] = (start, d.width == 2 && start + 1 < dims);
-            count += 1;
-        }
         FillLanes {
-            groups,
-            count,
+            groups: LaneGroups::of(setup, dims),
             seed: keys.map(|k| k.seed),
             strategy: keys.map(|k| k.strategy),
             pixel: keys.map(|k| k.pixel),
@@ -140,20 +131,10 @@ impl Kernel for FillLanes<'_> {
             index.shr(32),
         );
         let i = index.and(L::U::splat(0xffff_ffff));
-        let mut unit = [0.0f32; WIDTH];
-        for (g, &(start, pair)) in self.groups[..self.count].iter().enumerate() {
+        for (g, &(start, pair)) in self.groups.as_slice().iter().enumerate() {
             let seed = sequence.xor(L::U::splat(group_key(g)));
             let [x, y] = scrambled_point_lanes(owen_lanes(i, seed), seed, pair);
-            to_unit_lanes(x, &mut unit);
-            for (o, &u) in self.out.iter_mut().zip(unit.iter()) {
-                o[start] = u;
-            }
-            if pair {
-                to_unit_lanes(y, &mut unit);
-                for (o, &u) in self.out.iter_mut().zip(unit.iter()) {
-                    o[start + 1] = u;
-                }
-            }
+            store_point_lanes([x, y], start, pair, self.out);
         }
     }
 }

@@ -18,7 +18,7 @@
 //! the coordinates' scrambles, so large images still get distinct points.
 
 use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
-use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, to_unit_lanes};
+use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, LaneGroups, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 
@@ -231,8 +231,7 @@ fn pixel_morton(setup: &Setup, pixel: u64) -> u64 {
 /// [`ZSobol::fill_lanes`] as a lane kernel: the layout's groups below `dims` (each's first
 /// dimension, and whether it is a pair there) and the keys as lanes.
 struct FillLanes<'a> {
-    groups: [(usize, bool); MAX_DIMENSIONS],
-    count: usize,
+    groups: LaneGroups,
     blocks: Blocks,
     seed: [u64; WIDTH],
     strategy: [u64; WIDTH],
@@ -248,16 +247,8 @@ impl<'a> FillLanes<'a> {
         dims: usize,
         out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
     ) -> Self {
-        let dims = dims.min(MAX_DIMENSIONS);
-        let mut groups = [(0, false); MAX_DIMENSIONS];
-        let mut count = 0;
-        for (start, d) in setup.layout.offsets().take_while(|(s, _)| *s < dims) {
-            groups[count] = (start, d.width == 2 && start + 1 < dims);
-            count += 1;
-        }
         FillLanes {
-            groups,
-            count,
+            groups: LaneGroups::of(setup, dims),
             blocks: Blocks::of(setup),
             seed: keys.map(|k| k.seed),
             strategy: keys.map(|k| k.strategy),
@@ -275,19 +266,9 @@ impl Kernel for FillLanes<'_> {
         let load = L::U::load;
         let (index, morton, b) = (load(&self.index), load(&self.morton), self.blocks);
         let run = run_seed_lanes(load(&self.seed), load(&self.strategy), index, b);
-        let mut unit = [0.0f32; WIDTH];
-        for &(start, pair) in &self.groups[..self.count] {
+        for &(start, pair) in self.groups.as_slice() {
             let [x, y] = group_point_lanes(morton, index, run, start, pair, b);
-            to_unit_lanes(x, &mut unit);
-            for (o, &u) in self.out.iter_mut().zip(unit.iter()) {
-                o[start] = u;
-            }
-            if pair {
-                to_unit_lanes(y, &mut unit);
-                for (o, &u) in self.out.iter_mut().zip(unit.iter()) {
-                    o[start + 1] = u;
-                }
-            }
+            store_point_lanes([x, y], start, pair, self.out);
         }
     }
 }
