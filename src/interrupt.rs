@@ -49,10 +49,38 @@ pub fn install() {
     INSTALL.call_once(|| {
         #[cfg(unix)]
         process_hygiene();
+        #[cfg(unix)]
+        let ignored = inherited_ignores();
         if let Err(e) = ctrlc::set_handler(on_signal) {
             note(&format!("warning: cannot install the Ctrl-C handler: {e}"));
         }
+        #[cfg(unix)]
+        for sig in ignored {
+            // SAFETY: resets this process's own disposition of a signal it inherited ignored.
+            unsafe {
+                libc::signal(sig, libc::SIG_IGN);
+            }
+        }
     });
+}
+
+/// SIGHUP if this process was started with it ignored (`nohup`): it stays ignored. The handler
+/// covers SIGINT, SIGTERM and SIGHUP, and would otherwise end a `nohup` run when its terminal
+/// closes. (SIGINT is handled even when inherited ignored, as a shell without job control
+/// starts background commands: an explicit `kill -INT` is then still a Ctrl-C.)
+#[cfg(unix)]
+fn inherited_ignores() -> Vec<libc::c_int> {
+    [libc::SIGHUP]
+        .into_iter()
+        .filter(|&sig| {
+            // SAFETY: queries the disposition only (a null new action).
+            unsafe {
+                let mut old: libc::sigaction = std::mem::zeroed();
+                libc::sigaction(sig, std::ptr::null(), &mut old) == 0
+                    && old.sa_sigaction == libc::SIG_IGN
+            }
+        })
+        .collect()
 }
 
 #[cfg(unix)]

@@ -399,8 +399,20 @@ fn thread_states(pid: u32) -> String {
 }
 
 fn spawn(args: &[&str], cwd: &Path) -> std::process::Child {
-    bin()
-        .args(args)
+    use std::os::unix::process::CommandExt;
+    let mut cmd = bin();
+    // As from a terminal: a test run started in the background by a shell without job
+    // control inherits SIGINT ignored, and a Ctrl-C that lands before dibench installs its
+    // handler would then be lost (`ctrl_c_is_answered_in_every_phase` hung on it).
+    // SAFETY: `signal` is async-signal-safe, as `pre_exec` requires.
+    unsafe {
+        cmd.pre_exec(|| {
+            libc::signal(libc::SIGINT, libc::SIG_DFL);
+            libc::signal(libc::SIGHUP, libc::SIG_DFL);
+            Ok(())
+        });
+    }
+    cmd.args(args)
         .current_dir(cwd)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -776,4 +788,68 @@ fn closed_stdout_and_stderr_end_quietly() {
     check_run_dir(&run, true).unwrap();
     check_store(&dir.path().join("closed/tiny/reference"), true).unwrap();
     assert!(std::fs::read_to_string(dir.path().join("tiny.toml")).unwrap() == TINY);
+}
+
+/// `nohup dibench reference …`: started with SIGHUP ignored, a run survives its terminal's
+/// hang-up (the Ctrl-C handler must not take SIGHUP over), and still answers Ctrl-C. Its
+/// negative control is the same run started with SIGHUP at its default: the hang-up ends it.
+#[test]
+fn a_nohup_run_survives_a_hang_up() {
+    use std::os::unix::process::CommandExt;
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), TINY).unwrap();
+    for nohup in [true, false] {
+        let spawned = std::time::SystemTime::now();
+        let mut cmd = bin();
+        // SAFETY: `signal` is async-signal-safe, as `pre_exec` requires.
+        unsafe {
+            cmd.pre_exec(move || {
+                libc::signal(libc::SIGINT, libc::SIG_DFL);
+                libc::signal(
+                    libc::SIGHUP,
+                    if nohup { libc::SIG_IGN } else { libc::SIG_DFL },
+                );
+                Ok(())
+            });
+        }
+        let out = format!("out-{nohup}");
+        let mut child = cmd
+            .args([
+                "reference",
+                "tiny.toml",
+                "--spp",
+                "100000000",
+                "--threads",
+                "1",
+                "--out",
+                &out,
+            ])
+            .current_dir(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        wait_for_checkpoint(&dir.path().join(&out).join("tiny/reference"), spawned);
+        signal(child.id(), libc::SIGHUP);
+        std::thread::sleep(Duration::from_millis(1500));
+        let alive = child.try_wait().unwrap().is_none();
+        if !nohup {
+            if alive {
+                let _ = child.kill();
+            }
+            assert!(
+                !alive,
+                "a hang-up did not end a run that does not ignore it"
+            );
+            continue;
+        }
+        assert!(alive, "a nohup run ended on a hang-up");
+        let done = interrupt(child, 1);
+        assert_eq!(
+            done.status.code(),
+            Some(130),
+            "{}",
+            String::from_utf8_lossy(&done.stderr)
+        );
+    }
 }
