@@ -399,16 +399,26 @@ fn thread_states(pid: u32) -> String {
 }
 
 fn spawn(args: &[&str], cwd: &Path) -> std::process::Child {
+    spawn_with(args, cwd, false)
+}
+
+/// [`spawn`], with SIGHUP inherited ignored when `sighup_ignored` (as under `nohup`).
+fn spawn_with(args: &[&str], cwd: &Path, sighup_ignored: bool) -> std::process::Child {
     use std::os::unix::process::CommandExt;
     let mut cmd = bin();
     // As from a terminal: a test run started in the background by a shell without job
     // control inherits SIGINT ignored, and a Ctrl-C that lands before dibench installs its
     // handler would then be lost (`ctrl_c_is_answered_in_every_phase` hung on it).
+    let hangup = if sighup_ignored {
+        libc::SIG_IGN
+    } else {
+        libc::SIG_DFL
+    };
     // SAFETY: `signal` is async-signal-safe, as `pre_exec` requires.
     unsafe {
-        cmd.pre_exec(|| {
+        cmd.pre_exec(move || {
             libc::signal(libc::SIGINT, libc::SIG_DFL);
-            libc::signal(libc::SIGHUP, libc::SIG_DFL);
+            libc::signal(libc::SIGHUP, hangup);
             Ok(())
         });
     }
@@ -795,40 +805,22 @@ fn closed_stdout_and_stderr_end_quietly() {
 /// negative control is the same run started with SIGHUP at its default: the hang-up ends it.
 #[test]
 fn a_nohup_run_survives_a_hang_up() {
-    use std::os::unix::process::CommandExt;
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("tiny.toml"), TINY).unwrap();
     for nohup in [true, false] {
         let spawned = std::time::SystemTime::now();
-        let mut cmd = bin();
-        // SAFETY: `signal` is async-signal-safe, as `pre_exec` requires.
-        unsafe {
-            cmd.pre_exec(move || {
-                libc::signal(libc::SIGINT, libc::SIG_DFL);
-                libc::signal(
-                    libc::SIGHUP,
-                    if nohup { libc::SIG_IGN } else { libc::SIG_DFL },
-                );
-                Ok(())
-            });
-        }
         let out = format!("out-{nohup}");
-        let mut child = cmd
-            .args([
-                "reference",
-                "tiny.toml",
-                "--spp",
-                "100000000",
-                "--threads",
-                "1",
-                "--out",
-                &out,
-            ])
-            .current_dir(dir.path())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+        let args = [
+            "reference",
+            "tiny.toml",
+            "--spp",
+            "100000000",
+            "--threads",
+            "1",
+            "--out",
+            &out,
+        ];
+        let mut child = spawn_with(&args, dir.path(), nohup);
         wait_for_checkpoint(&dir.path().join(&out).join("tiny/reference"), spawned);
         signal(child.id(), libc::SIGHUP);
         std::thread::sleep(Duration::from_millis(1500));

@@ -14,7 +14,7 @@
 //! a fresh randomization (an epoch in the seed).
 
 use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
-use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, LaneGroups, store_point_lanes};
+use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, LaneGroups, LaneKeys, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 
@@ -93,10 +93,7 @@ impl SampleGenerator for Sobol {
 /// first dimension, and whether it is a pair there), and the keys as lanes.
 struct FillLanes<'a> {
     groups: LaneGroups,
-    seed: [u64; WIDTH],
-    strategy: [u64; WIDTH],
-    pixel: [u64; WIDTH],
-    index: [u64; WIDTH],
+    keys: LaneKeys,
     out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
 }
 
@@ -109,10 +106,7 @@ impl<'a> FillLanes<'a> {
     ) -> Self {
         FillLanes {
             groups: LaneGroups::of(setup, dims),
-            seed: keys.map(|k| k.seed),
-            strategy: keys.map(|k| k.strategy),
-            pixel: keys.map(|k| k.pixel),
-            index: keys.map(|k| k.index),
+            keys: LaneKeys::of(keys),
             out,
         }
     }
@@ -123,13 +117,10 @@ impl Kernel for FillLanes<'_> {
     #[inline(always)]
     fn run<L: Lanes>(self) {
         let load = L::U::load;
-        let index = load(&self.index);
-        let sequence = sequence_seed_lanes(
-            load(&self.seed),
-            load(&self.strategy),
-            load(&self.pixel),
-            index.shr(32),
-        );
+        let k = &self.keys;
+        let index = load(&k.index);
+        let sequence =
+            sequence_seed_lanes(load(&k.seed), load(&k.strategy), load(&k.pixel), index.shr(32));
         let i = index.and(L::U::splat(0xffff_ffff));
         for (g, &(start, pair)) in self.groups.as_slice().iter().enumerate() {
             let seed = sequence.xor(L::U::splat(group_key(g)));

@@ -18,7 +18,7 @@
 //! the coordinates' scrambles, so large images still get distinct points.
 
 use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
-use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, LaneGroups, store_point_lanes};
+use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, LaneGroups, LaneKeys, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 
@@ -233,10 +233,8 @@ fn pixel_morton(setup: &Setup, pixel: u64) -> u64 {
 struct FillLanes<'a> {
     groups: LaneGroups,
     blocks: Blocks,
-    seed: [u64; WIDTH],
-    strategy: [u64; WIDTH],
+    keys: LaneKeys,
     morton: [u64; WIDTH],
-    index: [u64; WIDTH],
     out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
 }
 
@@ -250,10 +248,8 @@ impl<'a> FillLanes<'a> {
         FillLanes {
             groups: LaneGroups::of(setup, dims),
             blocks: Blocks::of(setup),
-            seed: keys.map(|k| k.seed),
-            strategy: keys.map(|k| k.strategy),
+            keys: LaneKeys::of(keys),
             morton: keys.map(|k| pixel_morton(setup, k.pixel)),
-            index: keys.map(|k| k.index),
             out,
         }
     }
@@ -264,8 +260,9 @@ impl Kernel for FillLanes<'_> {
     #[inline(always)]
     fn run<L: Lanes>(self) {
         let load = L::U::load;
-        let (index, morton, b) = (load(&self.index), load(&self.morton), self.blocks);
-        let run = run_seed_lanes(load(&self.seed), load(&self.strategy), index, b);
+        let (k, b) = (&self.keys, self.blocks);
+        let (index, morton) = (load(&k.index), load(&self.morton));
+        let run = run_seed_lanes(load(&k.seed), load(&k.strategy), index, b);
         for &(start, pair) in self.groups.as_slice() {
             let [x, y] = group_point_lanes(morton, index, run, start, pair, b);
             store_point_lanes([x, y], start, pair, self.out);
