@@ -224,6 +224,31 @@ impl<'a> Dims<'a> {
     }
 }
 
+/// Asserts that a generator's packet fill gives each lane its single-sample numbers on every
+/// ISA, bit for bit: `fill(isa, out)` runs the packet kernel in that ISA's context.
+#[cfg(test)]
+pub(crate) fn assert_every_isa_fills_as_one_sample(
+    g: &dyn SampleGenerator,
+    setup: &Setup,
+    keys: &[SampleKey; WIDTH],
+    dims: usize,
+    fill: impl Fn(crate::simd::Isa, &mut [[f32; MAX_DIMENSIONS]; WIDTH]),
+    context: &str,
+) {
+    let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+    for (k, w) in keys.iter().zip(want.iter_mut()) {
+        g.fill(setup, *k, &mut w[..dims]);
+    }
+    let bits = |a: &[[f32; MAX_DIMENSIONS]; WIDTH]| {
+        a.map(|r| r[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+    };
+    for isa in crate::simd::Isa::available() {
+        let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+        fill(isa, &mut got);
+        assert_eq!(bits(&got), bits(&want), "{} {isa:?} {context}", g.name());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

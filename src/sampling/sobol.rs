@@ -133,6 +133,7 @@ impl Kernel for FillLanes<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::generator::assert_every_isa_fills_as_one_sample;
     use crate::sampling::{Dimension, Layout};
 
     /// Every ISA's packet fill gives each lane's single-sample numbers, for keys that differ
@@ -149,15 +150,13 @@ mod tests {
             pixel: i as u64 * 1_000_003,
             index: [0, 1, 7, u32::MAX as u64, 1 << 32, u64::MAX][i % 6].wrapping_sub(i as u64 / 6),
         });
-        let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-        for (k, w) in keys.iter().zip(want.iter_mut()) {
-            SOBOL.fill(&setup, *k, &mut w[..dims]);
-        }
-        for isa in Isa::available() {
-            let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-            crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, &mut got));
-            let bits = |a: &[[f32; MAX_DIMENSIONS]; WIDTH]| a.map(|r| r[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>());
-            assert_eq!(bits(&got), bits(&want), "{isa:?}");
-        }
+        assert_every_isa_fills_as_one_sample(
+            &SOBOL,
+            &setup,
+            &keys,
+            dims,
+            |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, got)),
+            "",
+        );
     }
 }

@@ -267,6 +267,7 @@ impl Kernel for FillLanes<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::generator::assert_every_isa_fills_as_one_sample;
 
     #[test]
     fn permute_is_a_bijection() {
@@ -299,18 +300,14 @@ mod tests {
                 pixel: i as u64 * 1_000_003,
                 index: i as u64 * 37 + [0, spp - 1, 5 * spp][i % 3],
             });
-            let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-            for (k, w) in keys.iter().zip(want.iter_mut()) {
-                STRATIFIED.fill(&setup, *k, &mut w[..dims]);
-            }
-            for isa in Isa::available() {
-                let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-                crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, &mut got));
-                let bits = |a: &[[f32; MAX_DIMENSIONS]; WIDTH]| {
-                    a.map(|r| r[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>())
-                };
-                assert_eq!(bits(&got), bits(&want), "{isa:?} spp {spp}");
-            }
+            assert_every_isa_fills_as_one_sample(
+                &STRATIFIED,
+                &setup,
+                &keys,
+                dims,
+                |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, got)),
+                &format!("spp {spp}"),
+            );
         }
     }
 }

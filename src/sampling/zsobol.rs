@@ -273,6 +273,7 @@ impl Kernel for FillLanes<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::generator::assert_every_isa_fills_as_one_sample;
     use crate::sampling::{Dimension, Layout};
 
     /// The packed lookup is the permutation table, entry by entry.
@@ -377,18 +378,14 @@ mod tests {
                 pixel: if i == 15 { u64::MAX } else { (i as u64 * 1_000_003) % pixels },
                 index: [0, 1, 7, 8, 1 << 16, u64::MAX][i % 6].wrapping_sub(i as u64 / 6),
             });
-            let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-            for (k, w) in keys.iter().zip(want.iter_mut()) {
-                ZSOBOL.fill(&setup, *k, &mut w[..dims]);
-            }
-            for isa in Isa::available() {
-                let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-                crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, &mut got));
-                let bits = |a: &[[f32; MAX_DIMENSIONS]; WIDTH]| {
-                    a.map(|r| r[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>())
-                };
-                assert_eq!(bits(&got), bits(&want), "{isa:?} {}x{}", setup.width, setup.height);
-            }
+            assert_every_isa_fills_as_one_sample(
+                &ZSOBOL,
+                &setup,
+                &keys,
+                dims,
+                |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, got)),
+                &format!("{}x{}", setup.width, setup.height),
+            );
         }
     }
 }
