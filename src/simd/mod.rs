@@ -138,6 +138,27 @@ pub trait Lanes: Copy {
     type U: VectorU64<WIDTH>;
 }
 
+/// Asks the cache for the `size_of::<T>()` bytes at `p` (one prefetch per 64-byte line), so a
+/// traversal can start the memory reads of the nodes it will visit next while it works on the
+/// current one. A hint only: no value depends on it, and an address that is not mapped is
+/// ignored by the CPU (`prefetcht0` never faults), so the pointer need not be dereferenceable.
+#[inline(always)]
+pub fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let mut off = 0;
+        while off < std::mem::size_of::<T>() {
+            // SAFETY: prefetch is a hint; it reads nothing architecturally and cannot fault.
+            // SSE is in the x86-64 baseline.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>((p as *const i8).wrapping_add(off)) };
+            off += 64;
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
+}
+
 /// A computation generic over the lane types; [`run`] instantiates it for one ISA. Mark `run`
 /// (and every function it calls on lanes) `#[inline(always)]`: only code inlined into the ISA's
 /// `#[target_feature]` entry is compiled for it, and an intrinsic outside it is a call.

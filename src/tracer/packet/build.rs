@@ -149,6 +149,20 @@ pub struct Wide {
     pub build_time: Duration,
 }
 
+impl Wide {
+    /// Starts the memory reads of a child's node or leaf block (see [`crate::simd::prefetch`]).
+    #[inline(always)]
+    pub fn prefetch(&self, c: Child) {
+        match c.kind() {
+            Kind::Inner(i) => crate::simd::prefetch(self.nodes.as_ptr().wrapping_add(i as usize)),
+            Kind::Block(b, _) => {
+                crate::simd::prefetch(self.blocks.as_ptr().wrapping_add(b as usize))
+            }
+            Kind::Sphere(_) | Kind::Empty => {}
+        }
+    }
+}
+
 /// Slots of a wide node.
 const SLOTS: usize = BRANCH;
 

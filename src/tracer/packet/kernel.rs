@@ -10,7 +10,7 @@
 //! without min/max, and a shared axis permutation (most coherent packets) drops the per-lane
 //! shuffles of the triangle test. Every variant computes the same values as the general one.
 
-use super::build::{Block, Child, Kind, MAX_ROW, Node};
+use super::build::{Block, Child, Kind, MAX_ROW, Node, Wide};
 use super::leaf::{self, Out, Sheared};
 use super::{Best, FAR_SCALE, FAULT_FAR_FIRST, PacketTracer, Ray1, STACK, TraceStats, single};
 use crate::geometry::Ray;
@@ -382,6 +382,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
     #[inline(always)]
     fn push_children<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         &self,
+        wide: &Wide,
         n: &Node,
         m: u32,
         cull: V,
@@ -422,6 +423,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
             }
         }
         for &(_, c, hm, entry) in &keys[..k] {
+            wide.prefetch(c);
             stack.push(c, hm, entry);
         }
     }
@@ -614,7 +616,7 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                 stats.packet_nodes += 1;
                 stats.packet_lanes += m.count_ones() as u64;
                 let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+                p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(&tr.wide, n, m, cull, &mut stack);
             }
             Kind::Block(b, count) => {
                 stats.leaves += 1;
@@ -732,7 +734,7 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                     let n = &tr.wide.nodes[i as usize];
                     stats.packet_nodes += 1;
                     stats.packet_lanes += m.count_ones() as u64;
-                    p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(n, m, cull, &mut stack);
+                    p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(&tr.wide, n, m, cull, &mut stack);
                 }
                 Kind::Block(b, count) => {
                     stats.leaves += 1;

@@ -133,6 +133,7 @@ pub fn closest<L: Lanes, const FAULT: u32>(
                     let far_first = FAULT & FAULT_FAR_FIRST != 0;
                     let add = |slot: usize, stack: &mut Stack| {
                         let e = (n.child[slot], near[slot]);
+                        tr.wide.prefetch(e.0);
                         let mut j = stack.sp;
                         stack.push(e.0, e.1);
                         while j > base {
@@ -218,6 +219,7 @@ pub fn occluded<L: Lanes, const FAULT: u32>(
                     while m != 0 {
                         let slot = m.trailing_zeros() as usize;
                         m &= m - 1;
+                        tr.wide.prefetch(n.child[slot]);
                         stack.push(n.child[slot], 0.0);
                     }
                     continue;
