@@ -313,8 +313,10 @@ fn leaf_keeps_the_conservative_t_rule() {
 }
 
 /// Closest hit visits children near to far: through a stack of 40 parallel quads a ray stops
-/// after the nearest leaf (the others are culled behind its hit), for single rays and packets.
-/// Negative control: the far-to-near kernel, still correct, tests many more leaves.
+/// after the nearest leaf (the others are culled behind its hit), for single rays and packets:
+/// a packet of parallel rays (per-lane slab tests) and a camera packet, whose rays share an
+/// origin (the interval test alone, with the hull's entry distances as keys). Negative control:
+/// the far-to-near kernel, still correct, tests many more leaves.
 #[test]
 fn closest_hit_visits_near_to_far() {
     let mut tris = vec![];
@@ -334,60 +336,63 @@ fn closest_hit_visits_near_to_far() {
         spheres: vec![],
     });
     let base = ObvhsTracer::build(g.clone());
-    let mut p = RayPacket::default();
-    for lane in 0..LANES {
-        let (x, y) = (
+    let grid = |lane: usize| {
+        (
             (lane % 4) as f32 * 0.1 - 0.15,
             (lane / 4) as f32 * 0.1 - 0.15,
-        );
-        p.set(
-            lane,
-            &Ray::new(
-                Vec3::new(x, y, 5.0),
-                Vec3::new(0.0, 0.0, -1.0),
-                f32::INFINITY,
-            ),
-        );
+        )
+    };
+    let (mut parallel, mut camera) = (RayPacket::default(), RayPacket::default());
+    for lane in 0..LANES {
+        let (x, y) = grid(lane);
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        parallel.set(lane, &Ray::new(Vec3::new(x, y, 5.0), down, f32::INFINITY));
+        let eye = Vec3::new(-0.3, -0.25, 5.0);
+        let d = (Vec3::new(x, y, 0.0) - eye).normalize();
+        camera.set(lane, &Ray::new(eye, d, f32::INFINITY));
     }
     for isa in Isa::available() {
         let tr = PacketTracer::build(g.clone(), isa).unwrap();
-        let (mut near, mut far) = (TraceStats::default(), TraceStats::default());
-        let mut h = HitPacket::default();
-        tr.closest_packet::<0>(&p, u16::MAX, &mut h, &mut near);
-        let mut hf = HitPacket::default();
-        tr.closest_packet::<FAULT_FAR_FIRST>(&p, u16::MAX, &mut hf, &mut far);
-        for lane in 0..LANES {
-            let ray = p.get(lane);
-            let want = bits(base.intersect(&ray));
-            assert_eq!(bits(h.get(lane)), want);
-            assert_eq!(bits(hf.get(lane)), want, "far to near is slower, not wrong");
-            let (mut s1, mut s2) = (TraceStats::default(), TraceStats::default());
-            assert_eq!(bits(tr.closest_single::<0>(&ray, &mut s1)), want);
-            assert_eq!(
-                bits(tr.closest_single::<FAULT_FAR_FIRST>(&ray, &mut s2)),
-                want
+        for (what, p) in [("parallel", &parallel), ("camera", &camera)] {
+            let (mut near, mut far) = (TraceStats::default(), TraceStats::default());
+            let mut h = HitPacket::default();
+            tr.closest_packet::<0>(p, u16::MAX, &mut h, &mut near);
+            let mut hf = HitPacket::default();
+            tr.closest_packet::<FAULT_FAR_FIRST>(p, u16::MAX, &mut hf, &mut far);
+            for lane in 0..LANES {
+                let ray = p.get(lane);
+                let want = bits(base.intersect(&ray));
+                assert!(want.is_some(), "{what}: lane {lane} misses the stack");
+                assert_eq!(bits(h.get(lane)), want);
+                assert_eq!(bits(hf.get(lane)), want, "far to near is slower, not wrong");
+                let (mut s1, mut s2) = (TraceStats::default(), TraceStats::default());
+                assert_eq!(bits(tr.closest_single::<0>(&ray, &mut s1)), want);
+                assert_eq!(
+                    bits(tr.closest_single::<FAULT_FAR_FIRST>(&ray, &mut s2)),
+                    want
+                );
+                assert!(
+                    s1.leaves <= 2,
+                    "{isa:?} {what}: single ray tested {} leaves",
+                    s1.leaves
+                );
+                assert!(
+                    s2.leaves >= 4,
+                    "{isa:?} {what}: negative control tested {} leaves",
+                    s2.leaves
+                );
+            }
+            assert!(
+                near.leaves <= 2,
+                "{isa:?} {what}: packet tested {} leaves",
+                near.leaves
             );
             assert!(
-                s1.leaves <= 2,
-                "{isa:?}: single ray tested {} leaves",
-                s1.leaves
-            );
-            assert!(
-                s2.leaves >= 4,
-                "{isa:?}: negative control tested {} leaves",
-                s2.leaves
+                far.leaves >= 4,
+                "{isa:?} {what}: negative control tested {} leaves",
+                far.leaves
             );
         }
-        assert!(
-            near.leaves <= 2,
-            "{isa:?}: packet tested {} leaves",
-            near.leaves
-        );
-        assert!(
-            far.leaves >= 4,
-            "{isa:?}: negative control tested {} leaves",
-            far.leaves
-        );
     }
 }
 

@@ -6,9 +6,12 @@
 //! 2012).
 //!
 //! Packet set-up is vectorised, and what the lanes share is used: a shared origin (camera
-//! rays) turns `box − origin` into scalar work, shared direction signs pick near/far planes
-//! without min/max, and a shared axis permutation (most coherent packets) drops the per-lane
-//! shuffles of the triangle test. Every variant computes the same values as the general one.
+//! rays) turns `box − origin` into scalar work and lets the packet descend on one interval
+//! (frustum) test per node with no per-lane slab tests (Wald et al. 2007; Embree's coherent
+//! kernels do the same), shared direction signs pick near/far planes without min/max, and a
+//! shared axis permutation (most coherent packets) drops the per-lane shuffles of the triangle
+//! test. Every variant finds the same hits as the general one: only culling differs, and it
+//! stays conservative.
 
 use super::build::{Block, Child, Kind, MAX_ROW, Node, Wide};
 use super::leaf::{self, Out, Sheared};
@@ -36,7 +39,8 @@ struct Prep<V> {
     /// Near-plane row per axis when every active lane's direction has the same sign there.
     near_row: [usize; 3],
     /// Per axis, the smallest and largest origin and reciprocal direction over the active
-    /// lanes: the interval test of all children at once (only with shared signs).
+    /// lanes: the interval test of all children at once (set only with shared signs; the
+    /// origins' only without a shared origin).
     o_lo: [f32; 3],
     o_hi: [f32; 3],
     i_lo: [f32; 3],
@@ -127,13 +131,21 @@ impl<V: Vector<WIDTH>> Prep<V> {
             let o0 = V::splat(origin[a]);
             let same = o[a].eq(o0) & !(o[a].sign() ^ o0.sign());
             shared &= same & active == active;
-            o_lo[a] = V::select(active, o[a], inf).reduce_min();
-            o_hi[a] = V::select(active, o[a], ninf).reduce_max();
-            i_lo[a] = V::select(active, inv[a], inf).reduce_min();
-            i_hi[a] = V::select(active, inv[a], ninf).reduce_max();
             let s = inv[a].sign() & active;
             signs &= s == 0 || s == active;
             near_row[a] = if s != 0 { a + MAX_ROW } else { a };
+        }
+        // The hulls only the interval tests read (shared signs), the origins' only without a
+        // shared origin (else they are `origin`).
+        if signs {
+            for a in 0..3 {
+                i_lo[a] = V::select(active, inv[a], inf).reduce_min();
+                i_hi[a] = V::select(active, inv[a], ninf).reduce_max();
+                if !shared {
+                    o_lo[a] = V::select(active, o[a], inf).reduce_min();
+                    o_hi[a] = V::select(active, o[a], ninf).reduce_max();
+                }
+            }
         }
         let shape = match (shared, signs) {
             (true, true) => Shape::Origin,
@@ -249,7 +261,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
 
     /// Lanes whose ray meets child `i`'s box within (0, cull); entry distances in `near_out`.
     #[inline(always)]
-    fn slab<const ORIGIN: bool, const SIGNS: bool>(
+    fn slab<const SIGNS: bool>(
         &self,
         n: &Node,
         i: usize,
@@ -272,17 +284,10 @@ impl<V: Vector<WIDTH>> Prep<V> {
             } else {
                 (a, a + MAX_ROW)
             };
-            let (b0, b1) = if ORIGIN {
-                (
-                    V::splat(n.b[lo][i] - self.origin[a]),
-                    V::splat(n.b[hi][i] - self.origin[a]),
-                )
-            } else {
-                (
-                    V::splat(n.b[lo][i]).sub(self.o[a]),
-                    V::splat(n.b[hi][i]).sub(self.o[a]),
-                )
-            };
+            let (b0, b1) = (
+                V::splat(n.b[lo][i]).sub(self.o[a]),
+                V::splat(n.b[hi][i]).sub(self.o[a]),
+            );
             let (t0, t1) = (b0.mul(self.inv[a]), b1.mul(self.inv[a]));
             if SIGNS {
                 near = t0.max(near);
@@ -302,11 +307,18 @@ impl<V: Vector<WIDTH>> Prep<V> {
     /// the largest cull distance of the lanes. Rounding is monotone, so the hull's extreme
     /// products bound every lane's computed distances: a child rejected here is rejected by
     /// each lane's own test (Wald et al. 2007's interval culling, exact in floating point).
+    /// `near_out` gets each child's hull entry distance, for the same reason at most every
+    /// lane's own.
     #[inline(always)]
-    fn interval<W: Vector<NARROW>, const ORIGIN: bool>(&self, n: &Node, cull_max: f32) -> u32 {
+    fn interval<W: Vector<NARROW>, const ORIGIN: bool>(
+        &self,
+        n: &Node,
+        cull_max: f32,
+        near_out: &mut [f32; NARROW],
+    ) -> u32 {
         let lo = [W::load(&n.b[0]), W::load(&n.b[1]), W::load(&n.b[2])];
         let hi = [W::load(&n.b[3]), W::load(&n.b[4]), W::load(&n.b[5])];
-        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0, cull_max)
+        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0, cull_max, near_out)
     }
 
     /// Triangles of a block that some lane may hit: [`Self::interval`] on the triangles'
@@ -329,7 +341,13 @@ impl<V: Vector<WIDTH>> Prep<V> {
             lo[a] = p.min(q).min(r);
             hi[a] = p.max(q).max(r);
         }
-        self.interval_boxes::<W, ORIGIN>(&lo, &hi, 1.0 + 1.0 / 65536.0, cull_max)
+        self.interval_boxes::<W, ORIGIN>(
+            &lo,
+            &hi,
+            1.0 + 1.0 / 65536.0,
+            cull_max,
+            &mut [0.0; NARROW],
+        )
     }
 
     /// The interval slab test of 8 boxes; `widen` ≥ 1 scales the far distances up and the
@@ -341,6 +359,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
         hi: &[W; 3],
         widen: f32,
         cull_max: f32,
+        near_out: &mut [f32; NARROW],
     ) -> u32 {
         let mut near = W::splat(0.0);
         let mut far = W::splat(f32::INFINITY);
@@ -374,6 +393,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
         } else {
             (near, far.mul(W::splat(FAR_SCALE)))
         };
+        near.store(near_out);
         near.le(far.min(W::splat(cull_max)))
     }
 
@@ -392,21 +412,35 @@ impl<V: Vector<WIDTH>> Prep<V> {
         let mut k = 0;
         let mut near = [0.0; WIDTH];
         let inf = V::splat(f32::INFINITY);
+        let mut hull_near = [0.0; NARROW];
         let mut cand = if SIGNS {
             let cull_max = V::select(m, cull, V::splat(f32::NEG_INFINITY)).reduce_max();
-            self.interval::<W, ORIGIN>(n, cull_max)
+            self.interval::<W, ORIGIN>(n, cull_max, &mut hull_near)
         } else {
             (1 << n.count) - 1
         };
         while cand != 0 {
             let i = cand.trailing_zeros() as usize;
             cand &= cand - 1;
-            let hit = m & self.slab::<ORIGIN, SIGNS>(n, i, cull, &mut near);
-            if hit != 0 {
+            let (hit, entry, key) = if ORIGIN {
+                // A shared origin (camera rays): the packet descends on the interval test
+                // alone, every lane with it, and the leaves' exact tests sort the lanes out.
+                // The hull's entry distance bounds every lane's from below, so dropping the
+                // lanes whose closest hit has passed it stays conservative. Per-lane slab
+                // tests cost more than the leaf tests they save on such packets (docs/tracer.md,
+                // stop 35); with different origins the hull is far too loose for this.
+                (m, hull_near[i], hull_near[i])
+            } else {
+                let hit = m & self.slab::<SIGNS>(n, i, cull, &mut near);
+                if hit == 0 {
+                    continue;
+                }
                 // The smallest entry distance of the child's lanes: lanes whose closest hit
                 // is nearer by the time it is popped skip it.
                 let entry = V::select(hit, V::load(&near), inf).reduce_min();
-                let key = near[hit.trailing_zeros() as usize];
+                (hit, entry, near[hit.trailing_zeros() as usize])
+            };
+            if hit != 0 {
                 let key = if FAULT & FAULT_FAR_FIRST != 0 {
                     -key
                 } else {
@@ -558,15 +592,16 @@ impl<const FAULT: u32> Kernel for Closest<'_, FAULT> {
                 closest::<L, FAULT, false, false>(tr, &p, rays, active, &mut best, stats)
             }
         }
-        let hits = self.hits;
-        for l in 0..WIDTH {
-            if best.prim[l] != NO_HIT {
-                hits.t[l] = best.t[l];
-                hits.prim[l] = best.prim[l];
-                hits.u[l] = best.u[l];
-                hits.v[l] = best.v[l];
-            }
+        // Lanes without a hit hold NO_HIT and u = v = 0 in `best` as in a missed lane of
+        // `HitPacket::default()`; only t differs (their tmax against ∞). Whole rows, no
+        // branch per lane.
+        let mut hit = 0u32;
+        for (l, &prim) in best.prim.iter().enumerate() {
+            hit |= ((prim != NO_HIT) as u32) << l;
         }
+        let hits = self.hits;
+        L::V::select(hit, L::V::load(&best.t), L::V::splat(f32::INFINITY)).store(&mut hits.t);
+        (hits.prim, hits.u, hits.v) = (best.prim, best.u, best.v);
     }
 }
 
