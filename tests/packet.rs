@@ -312,6 +312,37 @@ fn leaf_keeps_the_conservative_t_rule() {
     }
 }
 
+/// Camera packets take both paths of the closest-hit kernel: some nodes' children are entered
+/// on the interval test alone (few children overlap the packet), others with per-lane slab
+/// tests; on those packets the hits are obvhs's, bit for bit. Without the first count the
+/// interval-only path could be dead code that the contract tests never reach.
+#[test]
+fn camera_packets_take_the_interval_path() {
+    for name in ["bunny", "cornell"] {
+        let sc = scene(name);
+        let base = ObvhsTracer::build(sc.world.geometry.clone());
+        let sets = rays::generate(&sc, 48, 7);
+        let primary = sets.iter().find(|s| s.class == "primary").unwrap();
+        assert!(primary.coherent);
+        for isa in Isa::available() {
+            let tr = PacketTracer::build(sc.world.geometry.clone(), isa).unwrap();
+            let mut stats = TraceStats::default();
+            let mut tally = Tally::default();
+            for (p, &m) in primary.packets.iter().zip(&primary.masks) {
+                tr.intersect_packet_stats(p, m, &mut HitPacket::default(), &mut stats);
+                check_closest(&base, &tr, p, m, &mut tally);
+            }
+            assert!(
+                stats.frustum_nodes > 0 && stats.frustum_nodes < stats.packet_nodes,
+                "{name} {isa:?}: {} of {} packet visits on the interval test alone",
+                stats.frustum_nodes,
+                stats.packet_nodes
+            );
+            assert!(tally.hits > 1000, "{name}: too few hits: {tally:?}");
+        }
+    }
+}
+
 /// Closest hit visits children near to far: through a stack of 40 parallel quads a ray stops
 /// after the nearest leaf (the others are culled behind its hit), for single rays and packets:
 /// a packet of parallel rays (per-lane slab tests) and a camera packet, whose rays share an

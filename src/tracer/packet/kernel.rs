@@ -23,6 +23,14 @@ use std::mem::MaybeUninit;
 
 const FULL: u32 = (1 << WIDTH) - 1;
 
+/// A camera packet (a shared origin) whose interval test leaves at most this many of a node's
+/// children descends into them without per-lane slab tests. Chosen among 0 (per-lane tests
+/// always), 2, 3, 4 and 8 (never) on bunny, the dragon and cornell at 128² and 512²: never
+/// testing lanes is 3.5× slower on the dragon at 128², whose camera tiles span many
+/// triangles; 2 stays within the noise of per-lane tests there and keeps most of the gain on
+/// coherent packets (docs/tracer.md, stop 35).
+const FRUSTUM_CHILDREN: u32 = 2;
+
 /// Per-packet constants, computed across lanes with the scalar set-up's operations.
 struct Prep<V> {
     o: [V; 3],
@@ -398,7 +406,8 @@ impl<V: Vector<WIDTH>> Prep<V> {
     }
 
     /// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
-    /// entry distance of each child's first lane.
+    /// entry distance of each child's first lane (of the hull, when the interval test alone
+    /// decides: then it returns true).
     #[inline(always)]
     fn push_children<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         &self,
@@ -407,7 +416,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
         m: u32,
         cull: V,
         stack: &mut Stack,
-    ) {
+    ) -> bool {
         let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask, 0.0f32); 8];
         let mut k = 0;
         let mut near = [0.0; WIDTH];
@@ -419,16 +428,19 @@ impl<V: Vector<WIDTH>> Prep<V> {
         } else {
             (1 << n.count) - 1
         };
+        // A camera packet that overlaps few of the children lies (nearly) whole inside them:
+        // per-lane tests would pass every lane, so they are skipped. One that straddles more
+        // is spreading over geometry finer than itself, where per-lane masks save more leaf
+        // tests than they cost (docs/tracer.md, stop 35).
+        let frustum = ORIGIN && cand != 0 && cand.count_ones() <= FRUSTUM_CHILDREN;
         while cand != 0 {
             let i = cand.trailing_zeros() as usize;
             cand &= cand - 1;
-            let (hit, entry, key) = if ORIGIN {
-                // A shared origin (camera rays): the packet descends on the interval test
-                // alone, every lane with it, and the leaves' exact tests sort the lanes out.
-                // The hull's entry distance bounds every lane's from below, so dropping the
-                // lanes whose closest hit has passed it stays conservative. Per-lane slab
-                // tests cost more than the leaf tests they save on such packets (docs/tracer.md,
-                // stop 35); with different origins the hull is far too loose for this.
+            let (hit, entry, key) = if frustum {
+                // The packet descends on the interval test alone, every lane with it, and
+                // the leaves' exact tests sort the lanes out. The hull's entry distance bounds
+                // every lane's from below, so dropping the lanes whose closest hit has passed
+                // it stays conservative. (With different origins the hull is far too loose.)
                 (m, hull_near[i], hull_near[i])
             } else {
                 let hit = m & self.slab::<SIGNS>(n, i, cull, &mut near);
@@ -460,6 +472,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
             wide.prefetch(c);
             stack.push(c, hm, entry);
         }
+        frustum
     }
 }
 
@@ -651,7 +664,9 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                 stats.packet_nodes += 1;
                 stats.packet_lanes += m.count_ones() as u64;
                 let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(&tr.wide, n, m, cull, &mut stack);
+                stats.frustum_nodes += p
+                    .push_children::<L::W, FAULT, ORIGIN, SIGNS>(&tr.wide, n, m, cull, &mut stack)
+                    as u64;
             }
             Kind::Block(b, count) => {
                 stats.leaves += 1;
@@ -769,7 +784,9 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                     let n = &tr.wide.nodes[i as usize];
                     stats.packet_nodes += 1;
                     stats.packet_lanes += m.count_ones() as u64;
-                    p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(&tr.wide, n, m, cull, &mut stack);
+                    stats.frustum_nodes += p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(
+                        &tr.wide, n, m, cull, &mut stack,
+                    ) as u64;
                 }
                 Kind::Block(b, count) => {
                     stats.leaves += 1;

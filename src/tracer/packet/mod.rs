@@ -60,6 +60,8 @@ pub struct TraceStats {
     pub single_nodes: u64,
     /// Leaf blocks (or spheres) tested, by a packet or a single ray.
     pub leaves: u64,
+    /// Packet visits whose children were entered on the interval test alone (camera packets).
+    pub frustum_nodes: u64,
 }
 
 impl TraceStats {
@@ -68,6 +70,7 @@ impl TraceStats {
         self.packet_lanes += o.packet_lanes;
         self.single_nodes += o.single_nodes;
         self.leaves += o.leaves;
+        self.frustum_nodes += o.frustum_nodes;
     }
 }
 
