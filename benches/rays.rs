@@ -13,6 +13,9 @@
 //! `dibench rays` protocol), and prints Mrays/s per class with the measured lane occupancy:
 //! how `HYBRID_LANES`/`LEAF_LANES` were chosen. `DIBENCH_BUILD_SWEEP=1` does the same for
 //! build parameters (obvhs preset × SAH block cost), with build times and tree shapes.
+//! `DIBENCH_FRUSTUM_SWEEP=1` times camera rays (the `primary` class) at 128² and 512² on bunny,
+//! the dragon and cornell with several interval-only switches (`FRUSTUM_CHILDREN`): how it was
+//! chosen.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use dibench::harness::rays::{Subject, generate, measure, subjects};
@@ -68,6 +71,45 @@ fn hybrid_sweep() {
                 })
                 .collect();
             println!("  {:<15} {}", set.class, line.join("  "));
+        }
+    }
+}
+
+/// The interval-only switch sweep for camera packets (see the module docs).
+fn frustum_sweep() {
+    let variants = [None, Some(0), Some(2), Some(8)];
+    let isa = Isa::available()[0];
+    for name in ["bunny", "dragon", "cornell"] {
+        let Some(scene) = scene(name) else { continue };
+        for size in [128, 512] {
+            let sets: Vec<_> = generate(&scene, size, 1)
+                .into_iter()
+                .filter(|s| s.class == "primary")
+                .collect();
+            // One tree for every variant: separate copies of the dragon's would evict each
+            // other from the caches between rounds, and the order would decide.
+            let tr = PacketTracer::build(scene.world.geometry.clone(), isa).unwrap();
+            let subjects: Vec<Subject> = variants
+                .iter()
+                .map(|&k| Subject::Packet(tr.clone().with_frustum_children(k)))
+                .collect();
+            let rows = measure(name, &sets, &subjects, 9, 1);
+            let line: Vec<String> = rows
+                .iter()
+                .zip(&variants)
+                .map(|(r, k)| {
+                    format!(
+                        "{}: {:.2}",
+                        k.map_or("per-lane".into(), |k| k.to_string()),
+                        r.mrays_per_s
+                    )
+                })
+                .collect();
+            println!(
+                "frustum sweep, {name} {size}x{size}, {}: primary Mrays/s per interval-only switch  {}",
+                isa.name(),
+                line.join("  ")
+            );
         }
     }
 }
@@ -129,6 +171,9 @@ fn rays(c: &mut Criterion) {
     }
     if std::env::var_os("DIBENCH_BUILD_SWEEP").is_some() {
         build_sweep();
+    }
+    if std::env::var_os("DIBENCH_FRUSTUM_SWEEP").is_some() {
+        frustum_sweep();
     }
     for name in ["bunny", "dragon"] {
         let Some(scene) = scene(name) else { continue };

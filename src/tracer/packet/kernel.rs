@@ -7,8 +7,9 @@
 //!
 //! Packet set-up is vectorised, and what the lanes share is used: a shared origin (camera
 //! rays) turns `box − origin` into scalar work and lets the packet descend on one interval
-//! (frustum) test per node with no per-lane slab tests (Wald et al. 2007; Embree's coherent
-//! kernels do the same), shared direction signs pick near/far planes without min/max, and a
+//! (frustum) test per node, without per-lane slab tests where it overlaps at most two children
+//! or every lane is sure to pass them (Wald et al. 2007; Embree's coherent kernels descend on
+//! a frustum too), shared direction signs pick near/far planes without min/max, and a
 //! shared axis permutation (most coherent packets) drops the per-lane shuffles of the triangle
 //! test. Every variant finds the same hits as the general one: only culling differs, and it
 //! stays conservative.
@@ -22,14 +23,6 @@ use crate::tracer::{CULL_SCALE, HitPacket, LaneMask, NO_HIT, RayPacket};
 use std::mem::MaybeUninit;
 
 const FULL: u32 = (1 << WIDTH) - 1;
-
-/// A camera packet (a shared origin) whose interval test leaves at most this many of a node's
-/// children descends into them without per-lane slab tests. Chosen among 0 (per-lane tests
-/// always), 2, 3, 4 and 8 (never) on bunny, the dragon and cornell at 128² and 512²: never
-/// testing lanes is 3.5× slower on the dragon at 128², whose camera tiles span many
-/// triangles; 2 stays within the noise of per-lane tests there and keeps most of the gain on
-/// coherent packets (docs/tracer.md, stop 35).
-const FRUSTUM_CHILDREN: u32 = 2;
 
 /// Per-packet constants, computed across lanes with the scalar set-up's operations.
 struct Prep<V> {
@@ -405,6 +398,29 @@ impl<V: Vector<WIDTH>> Prep<V> {
         near.le(far.min(W::splat(cull_max)))
     }
 
+    /// Children that every lane of a shared-origin packet meets within (0, cull_min): the
+    /// interval test with the hull's other extremes, the largest entry and smallest exit
+    /// distances any lane can have. Rounding is monotone, so each lane's own slab test would
+    /// pass it: skipping that test loses nothing.
+    #[inline(always)]
+    fn every_lane<W: Vector<NARROW>>(&self, n: &Node, cull_min: f32) -> u32 {
+        let mut near = W::splat(0.0);
+        let mut far = W::splat(f32::INFINITY);
+        for a in 0..3 {
+            let (bn, bf) = if self.near_row[a] < MAX_ROW {
+                (W::load(&n.b[a]), W::load(&n.b[a + MAX_ROW]))
+            } else {
+                (W::load(&n.b[a + MAX_ROW]), W::load(&n.b[a]))
+            };
+            let (il, ih) = (W::splat(self.i_lo[a]), W::splat(self.i_hi[a]));
+            let o = W::splat(self.origin[a]);
+            let (dn, df) = (bn.sub(o), bf.sub(o));
+            near = dn.mul(il).max(dn.mul(ih)).max(near);
+            far = df.mul(il).min(df.mul(ih)).min(far);
+        }
+        near.le(far.mul(W::splat(FAR_SCALE)).min(W::splat(cull_min)))
+    }
+
     /// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
     /// entry distance of each child's first lane (of the hull, when the interval test alone
     /// decides: then it returns true).
@@ -416,6 +432,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
         m: u32,
         cull: V,
         stack: &mut Stack,
+        frustum_children: Option<u32>,
     ) -> bool {
         let mut keys = [(0.0f32, Child::EMPTY, 0 as Mask, 0.0f32); 8];
         let mut k = 0;
@@ -428,15 +445,27 @@ impl<V: Vector<WIDTH>> Prep<V> {
         } else {
             (1 << n.count) - 1
         };
-        // A camera packet that overlaps few of the children lies (nearly) whole inside them:
-        // per-lane tests would pass every lane, so they are skipped. One that straddles more
-        // is spreading over geometry finer than itself, where per-lane masks save more leaf
-        // tests than they cost (docs/tracer.md, stop 35).
-        let frustum = ORIGIN && cand != 0 && cand.count_ones() <= FRUSTUM_CHILDREN;
+        // Children a shared-origin packet enters on the interval test alone: those every lane
+        // is sure to meet (skipping their per-lane tests loses nothing), and all of them when
+        // at most `frustum_children` overlap the packet: it then lies (nearly) whole inside
+        // them, and per-lane masks would cost more than the leaf tests they save. A packet
+        // straddling more children is spreading over geometry finer than itself (docs/tracer.md,
+        // stop 35).
+        let sure = match frustum_children {
+            Some(k) if ORIGIN && cand != 0 => {
+                if cand.count_ones() <= k {
+                    cand
+                } else {
+                    let cull_min = V::select(m, cull, V::splat(f32::INFINITY)).reduce_min();
+                    self.every_lane::<W>(n, cull_min) & cand
+                }
+            }
+            _ => 0,
+        };
         while cand != 0 {
             let i = cand.trailing_zeros() as usize;
             cand &= cand - 1;
-            let (hit, entry, key) = if frustum {
+            let (hit, entry, key) = if sure >> i & 1 != 0 {
                 // The packet descends on the interval test alone, every lane with it, and
                 // the leaves' exact tests sort the lanes out. The hull's entry distance bounds
                 // every lane's from below, so dropping the lanes whose closest hit has passed
@@ -472,7 +501,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
             wide.prefetch(c);
             stack.push(c, hm, entry);
         }
-        frustum
+        sure != 0
     }
 }
 
@@ -664,9 +693,14 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                 stats.packet_nodes += 1;
                 stats.packet_lanes += m.count_ones() as u64;
                 let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                stats.frustum_nodes += p
-                    .push_children::<L::W, FAULT, ORIGIN, SIGNS>(&tr.wide, n, m, cull, &mut stack)
-                    as u64;
+                stats.frustum_nodes += p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(
+                    &tr.wide,
+                    n,
+                    m,
+                    cull,
+                    &mut stack,
+                    tr.frustum_children,
+                ) as u64;
             }
             Kind::Block(b, count) => {
                 stats.leaves += 1;
@@ -785,7 +819,12 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                     stats.packet_nodes += 1;
                     stats.packet_lanes += m.count_ones() as u64;
                     stats.frustum_nodes += p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(
-                        &tr.wide, n, m, cull, &mut stack,
+                        &tr.wide,
+                        n,
+                        m,
+                        cull,
+                        &mut stack,
+                        tr.frustum_children,
                     ) as u64;
                 }
                 Kind::Block(b, count) => {

@@ -49,6 +49,12 @@ pub const HYBRID_LANES: u32 = 6;
 /// a whole 8-triangle block, so a packet keeps testing leaves with fewer lanes.
 pub const LEAF_LANES: u32 = 3;
 
+/// A camera packet (a shared origin) whose interval test leaves at most this many of a node's
+/// children descends into them without per-lane slab tests (into more, only where every lane
+/// is sure to pass). Chosen on bunny, the dragon and cornell at 128² and 512²
+/// (`DIBENCH_FRUSTUM_SWEEP=1 cargo bench --bench rays`): docs/tracer.md, stop 35.
+pub const FRUSTUM_CHILDREN: u32 = 2;
+
 /// Work counters, for the `rays` harness.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct TraceStats {
@@ -60,7 +66,7 @@ pub struct TraceStats {
     pub single_nodes: u64,
     /// Leaf blocks (or spheres) tested, by a packet or a single ray.
     pub leaves: u64,
-    /// Packet visits whose children were entered on the interval test alone (camera packets).
+    /// Packet visits that entered some child on the interval test alone (camera packets).
     pub frustum_nodes: u64,
 }
 
@@ -171,12 +177,18 @@ impl Ray1 {
     }
 }
 
+#[derive(Clone)]
 pub struct PacketTracer {
     geometry: Arc<Geometry>,
-    wide: Wide,
+    /// Shared by the variants of [`Self::with_hybrid`] and [`Self::with_frustum_children`].
+    wide: Arc<Wide>,
     isa: Isa,
     /// The hybrid switch: (node, leaf) lane counts below which lanes go on alone.
     hybrid: (u32, u32),
+    /// A camera packet enters a node's children on the interval test alone when at most this
+    /// many overlap it, and those every lane is sure to meet whatever their number
+    /// ([`FRUSTUM_CHILDREN`]); None: per-lane tests at every node.
+    frustum_children: Option<u32>,
 }
 
 impl PacketTracer {
@@ -196,9 +208,10 @@ impl PacketTracer {
         }
         Ok(PacketTracer {
             geometry,
-            wide,
+            wide: Arc::new(wide),
             isa,
             hybrid: (HYBRID_LANES, LEAF_LANES),
+            frustum_children: Some(FRUSTUM_CHILDREN),
         })
     }
 
@@ -206,6 +219,14 @@ impl PacketTracer {
     /// below `node` (`leaf`) active lanes; 0 keeps packets whole, 17 traces every ray alone.
     pub fn with_hybrid(mut self, node: u32, leaf: u32) -> Self {
         self.hybrid = (node, leaf);
+        self
+    }
+
+    /// Another interval-only switch for camera packets (benches that tune it): None tests every
+    /// child per lane, Some(0) only skips the tests that every lane is sure to pass, Some(8)
+    /// never tests lanes.
+    pub fn with_frustum_children(mut self, children: Option<u32>) -> Self {
+        self.frustum_children = children;
         self
     }
 
