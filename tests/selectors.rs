@@ -20,7 +20,8 @@ use glam::Vec3;
 use selectors_common::{Rng, Spec, contexts, lights, mixed, quad, selectors};
 
 /// Σ pmf = 1 wherever `sample` can return a light (0 where it cannot), and every sampled
-/// (light, p) has p == pmf(light) exactly.
+/// (light, p) has p == pmf(light) exactly; a selector that claims a `constant` choice returns
+/// exactly it from every point.
 fn consistency(
     sel: &dyn LightSelector,
     n: usize,
@@ -32,7 +33,13 @@ fn consistency(
         let sum: f64 = (0..n).map(|i| sel.pmf(ctx, i) as f64).sum();
         let mut any = false;
         for _ in 0..16 {
-            if let Some((i, p)) = sel.sample(ctx, r.u64()) {
+            let got = sel.sample(ctx, r.u64());
+            if let Some(c) = sel.constant()
+                && got != Some(c)
+            {
+                return Err(format!("point {k}: constant {c:?} but sample gave {got:?}"));
+            }
+            if let Some((i, p)) = got {
                 any = true;
                 let q = sel.pmf(ctx, i);
                 if p != q || p <= 0.0 || p.is_nan() {
@@ -66,6 +73,43 @@ fn pmf_sums_to_one_and_equals_what_sample_reports() {
             }
         }
     }
+}
+
+/// Over one light, power and uniform selection claim their only choice as constant (the
+/// light estimators then skip the per-lane call), and it is what `sample` returns; over
+/// several lights no selector claims one. Negative control: a claimed constant with the
+/// wrong probability.
+#[test]
+fn a_constant_choice_is_what_sample_returns() {
+    let ctxs = contexts(5, 200);
+    let one = lights(&mixed(4, 1, false));
+    for (name, sel) in selectors(&one) {
+        if matches!(name, "power" | "uniform") {
+            assert_eq!(sel.constant().map(|c| c.0), Some(0), "{name}");
+        }
+        if let Err(e) = consistency(sel.as_ref(), 1, &ctxs, 13) {
+            panic!("{name} over one light: {e}");
+        }
+    }
+    let many = lights(&mixed(4, 20, false));
+    for (name, sel) in selectors(&many) {
+        assert_eq!(sel.constant(), None, "{name} over 20 lights");
+    }
+    struct Halved(Box<dyn LightSelector>);
+    impl LightSelector for Halved {
+        fn sample(&self, ctx: &LightCtx, u: f64) -> Option<(usize, f32)> {
+            self.0.sample(ctx, u)
+        }
+        fn pmf(&self, ctx: &LightCtx, light: usize) -> f32 {
+            self.0.pmf(ctx, light)
+        }
+        fn constant(&self) -> Option<(usize, f32)> {
+            self.0.constant().map(|(i, p)| (i, p * 0.5))
+        }
+    }
+    let power = (dibench::lights::selector::power::POWER.build)(&one).unwrap();
+    let e = consistency(&Halved(power), 1, &ctxs, 13).unwrap_err();
+    eprintln!("caught: {e}");
 }
 
 /// pbrt-v4's infinite-light pmf 1/(n∞ + 1) reported for lights the BVH samples by irradiance:

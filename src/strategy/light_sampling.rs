@@ -231,15 +231,17 @@ impl<'s> BoundLights<'s> {
         let mut x = ShadowLanes::default();
         let mut light = [usize::MAX; LANES];
         let mut chosen = 0u32;
+        // One dynamic call per packet, not per lane, where the choice cannot vary (one light).
+        let constant = self.selector.constant();
         for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
             let Some(sp) = sp else { continue };
             let u_select = u.get_1d();
             let ul = u.get_3d();
             let ctx = sp.light_ctx();
-            let Some((i, pmf)) = self
-                .selector
-                .sample(&ctx, selection_number(u_select, ul[2]))
-            else {
+            let Some((i, pmf)) = constant.or_else(|| {
+                self.selector
+                    .sample(&ctx, selection_number(u_select, ul[2]))
+            }) else {
                 continue;
             };
             light[lane] = i;

@@ -16,6 +16,13 @@ pub trait LightSelector: Send + Sync {
 
     /// The probability that [`Self::sample`] returns `light` from `ctx`.
     fn pmf(&self, ctx: &LightCtx, light: usize) -> f32;
+
+    /// What [`Self::sample`] returns from every point for every u, where that is one answer
+    /// (a selector over one light that can always pick it): callers may skip asking per
+    /// sample. None by default, always correct.
+    fn constant(&self) -> Option<(usize, f32)> {
+        None
+    }
 }
 
 /// Builds a selector over a scene's lights, or says why it cannot select among them.

@@ -29,6 +29,11 @@ impl LightSelector for PowerSelector {
     fn pmf(&self, _ctx: &LightCtx, light: usize) -> f32 {
         self.0.pmf(light)
     }
+
+    /// One light: the table's only bin, kept whole (q = 1), whatever u is.
+    fn constant(&self) -> Option<(usize, f32)> {
+        (self.0.len() == 1).then(|| (0, self.0.pmf(0)))
+    }
 }
 
 #[cfg(test)]

@@ -30,4 +30,8 @@ impl LightSelector for UniformSelector {
     fn pmf(&self, _ctx: &LightCtx, _light: usize) -> f32 {
         (1.0 / self.n as f64) as f32
     }
+
+    fn constant(&self) -> Option<(usize, f32)> {
+        (self.n == 1).then(|| (0, (1.0 / self.n as f64) as f32))
+    }
 }
