@@ -67,72 +67,83 @@ impl RunDir {
         // Built under a temporary name (with this process's pid, see `is_dead_temp`), locked and
         // with its run.json, then renamed into place: a run directory never exists without
         // both, so a free lock on one always means a dead run.
-        let mut builder = tempfile::Builder::new();
-        let prefix = format!(".{base}.{}.", std::process::id());
-        builder.prefix(&prefix).suffix(super::TEMP_SUFFIX);
-        #[cfg(unix)]
-        {
-            use std::os::unix::fs::PermissionsExt;
-            builder.permissions(std::fs::Permissions::from_mode(0o777));
-        }
-        let tmp = builder
-            .tempdir_in(scene_dir)
-            .map_err(|e| Error::io(scene_dir, e))?;
-        let lock_path = tmp.path().join(LOCK);
-        let lock = super::open_lock(&lock_path, true)?;
-        lock.lock().map_err(|e| Error::io(&lock_path, e))?;
-        let building = Shared {
-            path: tmp.path().to_path_buf(),
-            record: Mutex::new(None),
-            keep: AtomicBool::new(false),
-        };
-        building.write(Value::Object(Default::default()), Status::Running, None)?;
-        let mut k = 1u32;
-        let path = loop {
-            let name = if k == 1 {
-                base.to_string()
-            } else {
-                format!("{base}-{k}")
-            };
-            let path = scene_dir.join(name);
-            // rename(2) replaces only an empty directory; a run directory never is one.
-            match std::fs::rename(tmp.path(), &path) {
-                Ok(()) => break path,
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        std::io::ErrorKind::AlreadyExists | std::io::ErrorKind::DirectoryNotEmpty
-                    ) && k < 10_000 =>
-                {
-                    k += 1
-                }
-                Err(e) => {
-                    return Err(Error::Output {
-                        path,
-                        message: format!("cannot create the run directory: {e}"),
-                    });
-                }
+        // The whole build is one critical section: an exit on Ctrl-C waits for it (within
+        // its grace), and if it cannot, the hook registered right after the directory's
+        // creation removes it, so no interrupt leaves a directory under its temporary name.
+        crate::interrupt::critical(|| -> Result<RunDir> {
+            let mut builder = tempfile::Builder::new();
+            let prefix = format!(".{base}.{}.", std::process::id());
+            builder.prefix(&prefix).suffix(super::TEMP_SUFFIX);
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                builder.permissions(std::fs::Permissions::from_mode(0o777));
             }
-        };
-        // Renamed: nothing left for the temporary directory to remove.
-        let _ = tmp.keep();
-        let shared = Arc::new(Shared {
-            path: path.clone(),
-            record: Mutex::new(
-                building
-                    .record
-                    .into_inner()
-                    .unwrap_or_else(|p| p.into_inner()),
-            ),
-            keep: AtomicBool::new(false),
-        });
-        let on_exit = shared.clone();
-        let hook = crate::interrupt::on_exit(move || on_exit.abandon(Status::Interrupted, None));
-        Ok(RunDir {
-            path,
-            shared,
-            _lock: lock,
-            _hook: hook,
+            let tmp = builder
+                .tempdir_in(scene_dir)
+                .map_err(|e| Error::io(scene_dir, e))?;
+            let tmp_path = tmp.path().to_path_buf();
+            let _building = crate::interrupt::on_exit(move || {
+                let _ = std::fs::remove_dir_all(&tmp_path);
+            });
+            let lock_path = tmp.path().join(LOCK);
+            let lock = super::open_lock(&lock_path, true)?;
+            lock.lock().map_err(|e| Error::io(&lock_path, e))?;
+            let building = Shared {
+                path: tmp.path().to_path_buf(),
+                record: Mutex::new(None),
+                keep: AtomicBool::new(false),
+            };
+            building.write(Value::Object(Default::default()), Status::Running, None)?;
+            let mut k = 1u32;
+            let path = loop {
+                let name = if k == 1 {
+                    base.to_string()
+                } else {
+                    format!("{base}-{k}")
+                };
+                let path = scene_dir.join(name);
+                // rename(2) replaces only an empty directory; a run directory never is one.
+                match std::fs::rename(tmp.path(), &path) {
+                    Ok(()) => break path,
+                    Err(e)
+                        if matches!(
+                            e.kind(),
+                            std::io::ErrorKind::AlreadyExists
+                                | std::io::ErrorKind::DirectoryNotEmpty
+                        ) && k < 10_000 =>
+                    {
+                        k += 1
+                    }
+                    Err(e) => {
+                        return Err(Error::Output {
+                            path,
+                            message: format!("cannot create the run directory: {e}"),
+                        });
+                    }
+                }
+            };
+            // Renamed: nothing left for the temporary directory to remove.
+            let _ = tmp.keep();
+            let shared = Arc::new(Shared {
+                path: path.clone(),
+                record: Mutex::new(
+                    building
+                        .record
+                        .into_inner()
+                        .unwrap_or_else(|p| p.into_inner()),
+                ),
+                keep: AtomicBool::new(false),
+            });
+            let on_exit = shared.clone();
+            let hook =
+                crate::interrupt::on_exit(move || on_exit.abandon(Status::Interrupted, None));
+            Ok(RunDir {
+                path,
+                shared,
+                _lock: lock,
+                _hook: hook,
+            })
         })
     }
 
