@@ -421,6 +421,31 @@ impl<V: Vector<WIDTH>> Prep<V> {
         near.le(far.mul(W::splat(FAR_SCALE)).min(W::splat(cull_min)))
     }
 
+    /// A packet's visit of inner node `i` with the lanes in `m`: counted, its children tested
+    /// and the hit ones pushed.
+    #[inline(always)]
+    fn visit<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+        &self,
+        tr: &PacketTracer,
+        i: u32,
+        m: u32,
+        cull: V,
+        stack: &mut Stack,
+        stats: &mut TraceStats,
+    ) {
+        stats.packet_nodes += 1;
+        stats.packet_lanes += m.count_ones() as u64;
+        let n = &tr.wide.nodes[i as usize];
+        stats.frustum_nodes += self.push_children::<W, FAULT, ORIGIN, SIGNS>(
+            &tr.wide,
+            n,
+            m,
+            cull,
+            stack,
+            tr.frustum_children,
+        ) as u64;
+    }
+
     /// Tests a node's children for the lanes in `m` and pushes the hit ones, far first by the
     /// entry distance of each child's first lane (of the hull, when the interval test alone
     /// decides: then it returns true).
@@ -689,18 +714,8 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         }
         match c.kind() {
             Kind::Inner(i) => {
-                let n = &tr.wide.nodes[i as usize];
-                stats.packet_nodes += 1;
-                stats.packet_lanes += m.count_ones() as u64;
                 let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                stats.frustum_nodes += p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(
-                    &tr.wide,
-                    n,
-                    m,
-                    cull,
-                    &mut stack,
-                    tr.frustum_children,
-                ) as u64;
+                p.visit::<L::W, FAULT, ORIGIN, SIGNS>(tr, i, m, cull, &mut stack, stats);
             }
             Kind::Block(b, count) => {
                 stats.leaves += 1;
@@ -815,17 +830,7 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         } else {
             match c.kind() {
                 Kind::Inner(i) => {
-                    let n = &tr.wide.nodes[i as usize];
-                    stats.packet_nodes += 1;
-                    stats.packet_lanes += m.count_ones() as u64;
-                    stats.frustum_nodes += p.push_children::<L::W, FAULT, ORIGIN, SIGNS>(
-                        &tr.wide,
-                        n,
-                        m,
-                        cull,
-                        &mut stack,
-                        tr.frustum_children,
-                    ) as u64;
+                    p.visit::<L::W, FAULT, ORIGIN, SIGNS>(tr, i, m, cull, &mut stack, stats);
                 }
                 Kind::Block(b, count) => {
                     stats.leaves += 1;
