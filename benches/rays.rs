@@ -42,15 +42,11 @@ fn hybrid_sweep() {
     for name in ["bunny", "dragon"] {
         let Some(scene) = scene(name) else { continue };
         let sets = generate(&scene, 256, 1);
+        // One tree for every variant (see frustum_sweep).
+        let tr = PacketTracer::build(scene.world.geometry.clone(), isa).unwrap();
         let subjects: Vec<Subject> = variants
             .iter()
-            .map(|&(n, l)| {
-                Subject::Packet(
-                    PacketTracer::build(scene.world.geometry.clone(), isa)
-                        .unwrap()
-                        .with_hybrid(n, l),
-                )
-            })
+            .map(|&(n, l)| Subject::Packet(tr.clone().with_hybrid(n, l)))
             .collect();
         let rows = measure(name, &sets, &subjects, 9, 1);
         println!(
