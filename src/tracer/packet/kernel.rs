@@ -365,15 +365,10 @@ impl<V: Vector<WIDTH>> Prep<V> {
         let mut near = W::splat(0.0);
         let mut far = W::splat(f32::INFINITY);
         for a in 0..3 {
-            let (bn, bf) = if self.near_row[a] < MAX_ROW {
-                (lo[a], hi[a])
-            } else {
-                (hi[a], lo[a])
-            };
+            let (bn, bf) = self.planes(lo, hi, a);
             let (il, ih) = (W::splat(self.i_lo[a]), W::splat(self.i_hi[a]));
             if ORIGIN {
-                let o = W::splat(self.origin[a]);
-                let (dn, df) = (bn.sub(o), bf.sub(o));
+                let (dn, df) = self.rel_planes(bn, bf, a);
                 near = dn.mul(il).min(dn.mul(ih)).max(near);
                 far = df.mul(il).max(df.mul(ih)).min(far);
             } else {
@@ -398,23 +393,37 @@ impl<V: Vector<WIDTH>> Prep<V> {
         near.le(far.min(W::splat(cull_max)))
     }
 
+    /// Axis `a`'s near and far planes of 8 boxes, by the shared direction sign.
+    #[inline(always)]
+    fn planes<W: Vector<NARROW>>(&self, lo: &[W; 3], hi: &[W; 3], a: usize) -> (W, W) {
+        if self.near_row[a] < MAX_ROW {
+            (lo[a], hi[a])
+        } else {
+            (hi[a], lo[a])
+        }
+    }
+
+    /// Planes relative to the shared origin along axis `a`.
+    #[inline(always)]
+    fn rel_planes<W: Vector<NARROW>>(&self, bn: W, bf: W, a: usize) -> (W, W) {
+        let o = W::splat(self.origin[a]);
+        (bn.sub(o), bf.sub(o))
+    }
+
     /// Children that every lane of a shared-origin packet meets within (0, cull_min): the
     /// interval test with the hull's other extremes, the largest entry and smallest exit
     /// distances any lane can have. Rounding is monotone, so each lane's own slab test would
     /// pass it: skipping that test loses nothing.
     #[inline(always)]
     fn every_lane<W: Vector<NARROW>>(&self, n: &Node, cull_min: f32) -> u32 {
+        let lo = [W::load(&n.b[0]), W::load(&n.b[1]), W::load(&n.b[2])];
+        let hi = [W::load(&n.b[3]), W::load(&n.b[4]), W::load(&n.b[5])];
         let mut near = W::splat(0.0);
         let mut far = W::splat(f32::INFINITY);
         for a in 0..3 {
-            let (bn, bf) = if self.near_row[a] < MAX_ROW {
-                (W::load(&n.b[a]), W::load(&n.b[a + MAX_ROW]))
-            } else {
-                (W::load(&n.b[a + MAX_ROW]), W::load(&n.b[a]))
-            };
+            let (bn, bf) = self.planes(&lo, &hi, a);
             let (il, ih) = (W::splat(self.i_lo[a]), W::splat(self.i_hi[a]));
-            let o = W::splat(self.origin[a]);
-            let (dn, df) = (bn.sub(o), bf.sub(o));
+            let (dn, df) = self.rel_planes(bn, bf, a);
             near = dn.mul(il).max(dn.mul(ih)).max(near);
             far = df.mul(il).min(df.mul(ih)).min(far);
         }
