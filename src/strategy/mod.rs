@@ -110,9 +110,16 @@ pub struct ShadingLanes {
 }
 
 impl ShadingLanes {
-    /// [`ShadingPoint::with_error`] over lanes, bit for bit.
+    /// [`ShadingPoint::with_error`] over lanes, bit for bit, written into `g` (every field,
+    /// every lane).
     #[inline(always)]
-    pub fn compute<V: Vector<WIDTH>>(p: V3<V>, p_error: V3<V>, ng: V3<V>, view_dir: V3<V>) -> Self {
+    pub fn compute<V: Vector<WIDTH>>(
+        p: V3<V>,
+        p_error: V3<V>,
+        ng: V3<V>,
+        view_dir: V3<V>,
+        g: &mut ShadingLanes,
+    ) {
         let n = V3::select(ng.dot(view_dir).lt(V::splat(0.0)), ng, -ng);
         let (s, t) = Frame::from_normal_lanes(n);
         let wo = -view_dir;
@@ -121,14 +128,12 @@ impl ShadingLanes {
             y: wo.dot(t),
             z: wo.dot(n),
         };
-        let mut g = ShadingLanes::default();
         n.store(&mut g.n);
         s.store(&mut g.s);
         t.store(&mut g.t);
         wo.store(&mut g.wo);
         wo_local.store(&mut g.wo_local);
         offset_ray_origin_lanes(p, p_error, n).store(&mut g.origin);
-        g
     }
 }
 
