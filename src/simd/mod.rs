@@ -174,7 +174,7 @@ pub fn run<K: Kernel>(isa: Isa, k: K) -> K::Out {
     match isa {
         #[cfg(target_arch = "x86_64")]
         Isa::Avx512 if isa.supported() => {
-            // SAFETY: the CPU reports avx512f.
+            // SAFETY: the CPU reports avx512f and avx512dq.
             unsafe { avx512::entry(k) }
         }
         #[cfg(target_arch = "x86_64")]
