@@ -17,7 +17,7 @@ fn fill_lanes(c: &mut Criterion) {
     let mut group = c.benchmark_group("fill_lanes");
     for g in GENERATORS.iter() {
         let mut pass = 0u64;
-        let mut out = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+        let mut out = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
         // 64 packets of 16 pixels per iteration: 1,024 samples.
         group.bench_function(g.name(), |b| {
             b.iter(|| {

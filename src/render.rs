@@ -13,7 +13,7 @@ use crate::geometry::triangle::Triangle;
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
 use crate::sampling::generator::MAX_DIMENSIONS;
 use crate::sampling::stream::name_id;
-use crate::sampling::{Dims, GENERATORS, SampleGenerator, SampleKey, Setup};
+use crate::sampling::{Dims, GENERATORS, LaneValues, SampleGenerator, SampleKey, Setup};
 use crate::scene::Camera;
 use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector};
 use crate::strategy::{
@@ -44,7 +44,7 @@ pub struct Renderer<'a> {
 struct CameraTile<'a> {
     radiance: [Vec3; LANES],
     points: [Option<ShadingPoint<'a>>; LANES],
-    values: [[f32; MAX_DIMENSIONS]; LANES],
+    values: LaneValues,
 }
 
 impl CameraTile<'_> {
@@ -52,7 +52,7 @@ impl CameraTile<'_> {
         CameraTile {
             radiance: [Vec3::ZERO; LANES],
             points: [None; LANES],
-            values: [[0.0; MAX_DIMENSIONS]; LANES],
+            values: [[0.0; LANES]; MAX_DIMENSIONS],
         }
     }
 }
@@ -248,10 +248,7 @@ impl<'a> Renderer<'a> {
         });
         self.generator
             .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
-        for (lane, v) in out.values.iter().enumerate() {
-            px.u[0][lane] = v[0];
-            px.u[1][lane] = v[1];
-        }
+        px.u = [out.values[0], out.values[1]];
         let TileScratch {
             cam,
             hits,
@@ -337,7 +334,7 @@ impl<'a> Renderer<'a> {
                 out.radiance[lane] += self.view.emitted(&surf, cam.get(lane).dir);
             }
             let mut sp =
-                ShadingPoint::from_lanes(&geo, lane, p, &world.materials[material as usize]);
+                ShadingPoint::from_lanes(geo, lane, p, &world.materials[material as usize]);
             sp.pixel = pixel;
             out.points[lane] = Some(sp);
         }
@@ -348,7 +345,7 @@ impl<'a> Renderer<'a> {
         let scene = self.scene;
         let mut radiance = tile.radiance;
         let mut dims: [Dims; LANES] =
-            std::array::from_fn(|lane| Dims::new(&tile.values[lane][2..self.dims]));
+            std::array::from_fn(|lane| Dims::lane(&tile.values, lane, 2, self.dims));
         let mut probes = [Probes::default(); LANES];
         self.estimator
             .sample_packet(&tile.points, &mut dims, &mut probes);
@@ -642,8 +639,11 @@ mod tests {
                 .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
             for (lane, &(x, y)) in coords.iter().enumerate() {
                 if active & (1 << lane) != 0 {
-                    let v = &out.values[lane];
-                    cam.set(lane, &camera_ray(camera, w, h, x, y, [v[0], v[1]]));
+                    let v = &out.values;
+                    cam.set(
+                        lane,
+                        &camera_ray(camera, w, h, x, y, [v[0][lane], v[1][lane]]),
+                    );
                 }
             }
             let mut hits = HitPacket::default();

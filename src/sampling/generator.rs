@@ -26,6 +26,12 @@ pub struct SampleKey {
 /// refused when it is bound to a scene.
 pub const MAX_DIMENSIONS: usize = 32;
 
+/// A packet's samples, dimension-major: `values[d][lane]` is dimension d of the lane's
+/// sample, so a generator that computes 16 lanes at once stores each dimension as one vector
+/// (lane-major rows cost 16 scattered stores per dimension: 2–3 % of a cornell `light`
+/// profile, docs/tracer.md, stop 36). [`Dims::lane`] reads one lane's dimensions.
+pub type LaneValues = [[f32; WIDTH]; MAX_DIMENSIONS];
+
 /// What a generator knows about the render it serves, fixed for the whole render: the full
 /// layout (the camera's pair first, then the strategy's), the sample count per pixel when it
 /// is known up front (a fixed `--spp`; None under a time budget), and the image size (a
@@ -80,21 +86,26 @@ pub trait SampleGenerator: Send + Sync {
     /// `setup.layout.len()`. Must depend on (setup, key) alone.
     fn fill(&self, setup: &Setup, key: SampleKey, out: &mut [f32]);
 
-    /// One packet's samples at once: `out[i][..dims]` = [`Self::fill`] of `keys[i]` for every
-    /// lane i whose bit is set in `lanes` (other lanes' values are unspecified). The default fills
-    /// lane by lane; a generator whose lanes can be computed side by side overrides it, and
-    /// must give the same numbers (the `lanes_fill_as_single_samples` test).
+    /// One packet's samples at once: `out[d][i]` for d < `dims` = dimension d of
+    /// [`Self::fill`] of `keys[i]`, for every lane i whose bit is set in `lanes` (other lanes'
+    /// values are unspecified). The default fills lane by lane; a generator whose lanes can be
+    /// computed side by side overrides it, and must give the same numbers (the
+    /// `lanes_fill_as_single_samples` test).
     fn fill_lanes(
         &self,
         setup: &Setup,
         keys: &[SampleKey; WIDTH],
         lanes: Mask,
         dims: usize,
-        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &mut LaneValues,
     ) {
-        for (lane, (key, o)) in keys.iter().zip(out.iter_mut()).enumerate() {
+        let mut row = [0.0f32; MAX_DIMENSIONS];
+        for (lane, key) in keys.iter().enumerate() {
             if lanes & (1 << lane) != 0 {
-                self.fill(setup, *key, &mut o[..dims]);
+                self.fill(setup, *key, &mut row[..dims]);
+                for (o, &v) in out.iter_mut().zip(&row[..dims]) {
+                    o[lane] = v;
+                }
             }
         }
     }
@@ -174,31 +185,51 @@ impl Dimension {
 /// `layout()` undercounts what it draws: a programming error, reported by name.
 #[derive(Debug)]
 pub struct Dims<'a> {
+    /// Dimension k is `values[k * stride]`, for k < `len`.
     values: &'a [f32],
+    stride: usize,
+    len: usize,
     next: usize,
 }
 
 impl<'a> Dims<'a> {
+    /// The dimensions of one sample stored in order.
     pub fn new(values: &'a [f32]) -> Self {
-        Dims { values, next: 0 }
+        Dims {
+            values,
+            stride: 1,
+            len: values.len(),
+            next: 0,
+        }
     }
 
-    /// The next `N` dimensions (one bounds check for all of them).
+    /// Dimensions `from..to` of lane `lane` of a packet's samples.
+    pub fn lane(values: &'a LaneValues, lane: usize, from: usize, to: usize) -> Self {
+        assert!(
+            lane < WIDTH && from <= to && to <= MAX_DIMENSIONS,
+            "lane {lane}, dimensions {from}..{to} of a packet"
+        );
+        Dims {
+            values: &values.as_flattened()[from * WIDTH + lane..],
+            stride: WIDTH,
+            len: to - from,
+            next: 0,
+        }
+    }
+
+    /// The next `N` dimensions.
     pub fn get<const N: usize>(&mut self) -> [f32; N] {
-        let Some(v) = self
-            .values
-            .get(self.next..self.next + N)
-            .and_then(|s| <[f32; N]>::try_from(s).ok())
-        else {
+        if self.next + N > self.len {
             panic!(
                 "a strategy read dimensions {}..{} of a sample laid out with {}: its layout() must declare every dimension it draws",
                 self.next,
                 self.next + N,
-                self.values.len()
+                self.len
             );
-        };
+        }
+        let (values, stride, next) = (self.values, self.stride, self.next);
         self.next += N;
-        v
+        std::array::from_fn(|k| values[(next + k) * stride])
     }
 
     pub fn get_1d(&mut self) -> f32 {
@@ -220,7 +251,7 @@ impl<'a> Dims<'a> {
 
     /// The dimensions not read yet (for a strategy that hands them to a part of its own).
     pub fn remaining(&self) -> usize {
-        self.values.len() - self.next
+        self.len - self.next
     }
 }
 
@@ -232,18 +263,25 @@ pub(crate) fn assert_every_isa_fills_as_one_sample(
     setup: &Setup,
     keys: &[SampleKey; WIDTH],
     dims: usize,
-    fill: impl Fn(crate::simd::Isa, &mut [[f32; MAX_DIMENSIONS]; WIDTH]),
+    fill: impl Fn(crate::simd::Isa, &mut LaneValues),
     context: &str,
 ) {
-    let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-    for (k, w) in keys.iter().zip(want.iter_mut()) {
-        g.fill(setup, *k, &mut w[..dims]);
+    let mut want = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
+    for (lane, k) in keys.iter().enumerate() {
+        let mut row = [0.0f32; MAX_DIMENSIONS];
+        g.fill(setup, *k, &mut row[..dims]);
+        for (w, &v) in want.iter_mut().zip(&row[..dims]) {
+            w[lane] = v;
+        }
     }
-    let bits = |a: &[[f32; MAX_DIMENSIONS]; WIDTH]| {
-        a.map(|r| r[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+    let bits = |a: &LaneValues| {
+        a[..dims]
+            .iter()
+            .map(|r| r.map(f32::to_bits))
+            .collect::<Vec<_>>()
     };
     for isa in crate::simd::Isa::available() {
-        let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+        let mut got = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
         fill(isa, &mut got);
         assert_eq!(bits(&got), bits(&want), "{} {isa:?} {context}", g.name());
     }
@@ -253,6 +291,34 @@ pub(crate) fn assert_every_isa_fills_as_one_sample(
 mod tests {
     use super::*;
     use crate::sampling::GENERATORS;
+
+    /// A lane's `Dims` over a packet's dimension-major values reads that lane's dimensions,
+    /// in order, from the first asked for up to the last (the last lane's last dimension
+    /// included), and refuses to read past them.
+    #[test]
+    fn a_lane_reads_its_own_dimensions_in_order() {
+        let mut v: LaneValues = [[0.0; WIDTH]; MAX_DIMENSIONS];
+        for (d, row) in v.iter_mut().enumerate() {
+            for (lane, x) in row.iter_mut().enumerate() {
+                *x = (d * 100 + lane) as f32;
+            }
+        }
+        for lane in [0, 5, WIDTH - 1] {
+            let at = |d: usize| (d * 100 + lane) as f32;
+            let mut dims = Dims::lane(&v, lane, 2, 7);
+            assert_eq!(dims.remaining(), 5);
+            assert_eq!(dims.get_1d(), at(2));
+            assert_eq!(dims.get_3d(), [at(3), at(4), at(5)]);
+            assert_eq!(dims.get_1d(), at(6));
+            assert_eq!((dims.used(), dims.remaining()), (5, 0));
+            let past = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| dims.get_1d()));
+            assert!(past.is_err(), "lane {lane} read past its layout");
+            let mut all = Dims::lane(&v, lane, 0, MAX_DIMENSIONS);
+            for d in 0..MAX_DIMENSIONS {
+                assert_eq!(all.get_1d(), at(d));
+            }
+        }
+    }
 
     /// Every generator's packet fill gives each active lane exactly its single-sample fill (the
     /// renderer fills packets, closed-form checks single samples: both must see the same
@@ -276,16 +342,19 @@ mod tests {
                     pixel: (i as u64 * 5) % 91,
                     index,
                 });
-                let mut got = [[-1.0f32; MAX_DIMENSIONS]; WIDTH];
+                let mut got = [[-1.0f32; WIDTH]; MAX_DIMENSIONS];
                 g.fill_lanes(&setup, &keys, lanes, dims, &mut got);
-                for (lane, row) in got.iter().enumerate() {
+                for lane in 0..WIDTH {
                     if lanes & (1 << lane) == 0 {
                         continue;
                     }
                     let mut want = [-1.0f32; MAX_DIMENSIONS];
                     g.fill(&setup, keys[lane], &mut want[..dims]);
                     assert_eq!(
-                        row[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                        got[..dims]
+                            .iter()
+                            .map(|d| d[lane].to_bits())
+                            .collect::<Vec<_>>(),
                         want[..dims].iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
                         "{} lane {lane}",
                         g.name()

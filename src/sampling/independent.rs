@@ -3,7 +3,7 @@
 //! sample is independent of every other, so per-pixel sample variances are variances of i.i.d.
 //! draws — the assumption the harness's error predictions make.
 
-use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 use super::stream::{SampleStream, next_1d_lanes};
 
@@ -42,7 +42,7 @@ impl SampleGenerator for Independent {
         keys: &[SampleKey; WIDTH],
         _lanes: Mask,
         dims: usize,
-        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &mut LaneValues,
     ) {
         let first = (keys[0].seed, keys[0].strategy);
         let shared = SampleStream::base(first.0, first.1);
@@ -72,7 +72,7 @@ struct FillLanes<'a> {
     pixel: [u64; WIDTH],
     pass: [u64; WIDTH],
     dims: usize,
-    out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    out: &'a mut LaneValues,
 }
 
 impl Kernel for FillLanes<'_> {
@@ -82,12 +82,8 @@ impl Kernel for FillLanes<'_> {
         let load = L::U::load;
         let (mut state, increment) =
             SampleStream::keyed_lanes(load(&self.base), load(&self.pixel), load(&self.pass));
-        let mut x = [0.0f32; WIDTH];
-        for d in 0..self.dims.min(MAX_DIMENSIONS) {
-            next_1d_lanes::<L::V, L::U>(&mut state, increment, &mut x);
-            for (o, &x) in self.out.iter_mut().zip(x.iter()) {
-                o[d] = x;
-            }
+        for d in self.out.iter_mut().take(self.dims) {
+            next_1d_lanes::<L::V, L::U>(&mut state, increment, d);
         }
     }
 }
@@ -124,6 +120,7 @@ mod tests {
 mod lane_tests {
     use super::*;
     use crate::sampling::Layout;
+    use crate::sampling::generator::MAX_DIMENSIONS;
 
     /// Every ISA's build of the packet fill gives the numbers of one stream at a time, for
     /// lanes of different strategies too (integer lanes: nothing may differ).
@@ -137,12 +134,16 @@ mod lane_tests {
             pixel: i as u64 * 1_000_003,
             index: u64::MAX - i as u64,
         });
-        let mut want = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
-        for (k, w) in keys.iter().zip(want.iter_mut()) {
-            INDEPENDENT.fill(&setup, *k, &mut w[..dims]);
+        let mut want = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
+        for (lane, k) in keys.iter().enumerate() {
+            let mut row = [0.0f32; MAX_DIMENSIONS];
+            INDEPENDENT.fill(&setup, *k, &mut row[..dims]);
+            for (w, &v) in want.iter_mut().zip(&row[..dims]) {
+                w[lane] = v;
+            }
         }
         for isa in Isa::available() {
-            let mut got = [[0.0f32; MAX_DIMENSIONS]; WIDTH];
+            let mut got = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
             crate::simd::run(
                 isa,
                 FillLanes {
@@ -153,7 +154,7 @@ mod lane_tests {
                     out: &mut got,
                 },
             );
-            let bits = |a: [[f32; MAX_DIMENSIONS]; WIDTH]| a.map(|r| r.map(f32::to_bits));
+            let bits = |a: LaneValues| a.map(|r| r.map(f32::to_bits));
             assert_eq!(bits(got), bits(want), "{isa:?}");
         }
     }

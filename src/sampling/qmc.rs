@@ -8,7 +8,7 @@
 //! of the pair is a (0,m,2)-net in base 2; across groups the index is shuffled with a different
 //! seed, so no two groups are correlated.
 
-use super::generator::{MAX_DIMENSIONS, SampleKey, Setup};
+use super::generator::{LaneValues, MAX_DIMENSIONS, SampleKey, Setup};
 use crate::math::mix64_lanes;
 use crate::simd::{VectorU64, WIDTH};
 
@@ -179,24 +179,17 @@ impl LaneGroups {
 }
 
 /// Writes one group's point of every lane (32-bit fractions) as numbers in [0, 1) into
-/// dimension `start` of each lane's row, and its second coordinate into `start + 1` for a pair.
+/// dimension `start`, and its second coordinate into `start + 1` for a pair.
 #[inline(always)]
 pub fn store_point_lanes<U: VectorU64<WIDTH>>(
     point: [U; 2],
     start: usize,
     pair: bool,
-    out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    out: &mut LaneValues,
 ) {
-    let mut unit = [0.0f32; WIDTH];
-    to_unit_lanes(point[0], &mut unit);
-    for (o, &u) in out.iter_mut().zip(unit.iter()) {
-        o[start] = u;
-    }
+    to_unit_lanes(point[0], &mut out[start]);
     if pair {
-        to_unit_lanes(point[1], &mut unit);
-        for (o, &u) in out.iter_mut().zip(unit.iter()) {
-            o[start + 1] = u;
-        }
+        to_unit_lanes(point[1], &mut out[start + 1]);
     }
 }
 

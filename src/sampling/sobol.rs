@@ -13,7 +13,7 @@
 //! strategies or pixels never share points. Past 2^32 samples of a pixel the index wraps into
 //! a fresh randomization (an epoch in the seed).
 
-use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
 use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, LaneGroups, LaneKeys, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
@@ -83,7 +83,7 @@ impl SampleGenerator for Sobol {
         keys: &[SampleKey; WIDTH],
         _lanes: Mask,
         dims: usize,
-        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &mut LaneValues,
     ) {
         crate::simd::run(Isa::best(), FillLanes::new(setup, keys, dims, out));
     }
@@ -94,7 +94,7 @@ impl SampleGenerator for Sobol {
 struct FillLanes<'a> {
     groups: LaneGroups,
     keys: LaneKeys,
-    out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    out: &'a mut LaneValues,
 }
 
 impl<'a> FillLanes<'a> {
@@ -102,7 +102,7 @@ impl<'a> FillLanes<'a> {
         setup: &Setup,
         keys: &[SampleKey; WIDTH],
         dims: usize,
-        out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &'a mut LaneValues,
     ) -> Self {
         FillLanes {
             groups: LaneGroups::of(setup, dims),

@@ -9,7 +9,7 @@
 //! It needs N: under a time budget (`Setup::spp` None) `check` refuses, and `compare` says that
 //! `--sampler stratified` needs a fixed sample count.
 
-use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
 use super::qmc::{LaneGroups, LaneKeys};
 use super::stream::{ONE_MINUS_EPSILON, SampleStream, next_1d_lanes};
 use crate::math::mix64_lanes;
@@ -195,7 +195,7 @@ impl SampleGenerator for Stratified {
         keys: &[SampleKey; WIDTH],
         _lanes: Mask,
         dims: usize,
-        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &mut LaneValues,
     ) {
         crate::simd::run(Isa::best(), FillLanes::new(setup, keys, dims, out));
     }
@@ -209,7 +209,7 @@ struct FillLanes<'a> {
     jitter_base: [u64; WIDTH],
     epoch: [u64; WIDTH],
     k: [u64; WIDTH],
-    out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    out: &'a mut LaneValues,
 }
 
 impl<'a> FillLanes<'a> {
@@ -217,7 +217,7 @@ impl<'a> FillLanes<'a> {
         setup: &Setup,
         keys: &[SampleKey; WIDTH],
         dims: usize,
-        out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &'a mut LaneValues,
     ) -> Self {
         let strata = Strata::of(setup);
         let n = strata.walk.n;
@@ -256,9 +256,14 @@ impl Kernel for FillLanes<'_> {
             if pair {
                 next_1d_lanes::<L::V, L::U>(&mut state, increment, &mut j1);
             }
-            for (i, o) in self.out.iter_mut().enumerate() {
+            for i in 0..WIDTH {
                 let cell = walk.finish(first[i], [h[0][i], h[1][i], h[2][i]]);
-                store_group(o, start, pair, cell, self.strata, [j0[i], j1[i]]);
+                let mut v = [0.0f32; 2];
+                store_group(&mut v, 0, pair, cell, self.strata, [j0[i], j1[i]]);
+                self.out[start][i] = v[0];
+                if pair {
+                    self.out[start + 1][i] = v[1];
+                }
             }
         }
     }

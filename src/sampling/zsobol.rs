@@ -17,7 +17,7 @@
 //! The Sobol point is taken from the low 32 bits of the permuted index; the bits above seed
 //! the coordinates' scrambles, so large images still get distinct points.
 
-use super::generator::{MAX_DIMENSIONS, SampleGenerator, SampleKey, Setup};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
 use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, LaneGroups, LaneKeys, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
@@ -211,7 +211,7 @@ impl SampleGenerator for ZSobol {
         keys: &[SampleKey; WIDTH],
         _lanes: Mask,
         dims: usize,
-        out: &mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &mut LaneValues,
     ) {
         crate::simd::run(Isa::best(), FillLanes::new(setup, keys, dims, out));
     }
@@ -235,7 +235,7 @@ struct FillLanes<'a> {
     blocks: Blocks,
     keys: LaneKeys,
     morton: [u64; WIDTH],
-    out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+    out: &'a mut LaneValues,
 }
 
 impl<'a> FillLanes<'a> {
@@ -243,7 +243,7 @@ impl<'a> FillLanes<'a> {
         setup: &Setup,
         keys: &[SampleKey; WIDTH],
         dims: usize,
-        out: &'a mut [[f32; MAX_DIMENSIONS]; WIDTH],
+        out: &'a mut LaneValues,
     ) -> Self {
         FillLanes {
             groups: LaneGroups::of(setup, dims),
