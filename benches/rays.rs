@@ -11,7 +11,8 @@
 //! `DIBENCH_HYBRID_SWEEP=1 cargo bench --bench rays` first times the packet backend at the best
 //! ISA with several hybrid switches (node lanes, leaf lanes), interleaved round by round (the
 //! `dibench rays` protocol), and prints Mrays/s per class with the measured lane occupancy:
-//! how `HYBRID_LANES`/`LEAF_LANES` were chosen. `DIBENCH_BUILD_SWEEP=1` does the same for
+//! how `HYBRID_LANES`/`LEAF_LANES` were chosen. `DIBENCH_SWEEP_SIZE=N` sets its image size
+//! (N×N rays per class; 256 by default). `DIBENCH_BUILD_SWEEP=1` does the same for
 //! build parameters (obvhs preset × SAH block cost), with build times and tree shapes.
 //! `DIBENCH_FRUSTUM_SWEEP=1` times camera rays (the `primary` class) at 128² and 512² on bunny,
 //! the dragon and cornell with several interval-only switches (`FRUSTUM_CHILDREN`): how it was
@@ -36,12 +37,24 @@ fn scene(name: &str) -> Option<PreparedScene> {
 }
 
 /// The hybrid-switch sweep (see the module docs).
+/// The hybrid sweep's image size: `DIBENCH_SWEEP_SIZE`, else 256.
+fn sweep_size() -> u32 {
+    match std::env::var("DIBENCH_SWEEP_SIZE") {
+        Ok(v) => v
+            .parse()
+            .ok()
+            .filter(|&n| (4..=4096).contains(&n))
+            .unwrap_or_else(|| panic!("DIBENCH_SWEEP_SIZE={v}: give a size from 4 to 4096")),
+        Err(_) => 256,
+    }
+}
+
 fn hybrid_sweep() {
     let variants = [(0, 0), (4, 2), (6, 3), (8, 3), (8, 4), (10, 4), (17, 17)];
     let isa = Isa::available()[0];
     for name in ["bunny", "dragon"] {
         let Some(scene) = scene(name) else { continue };
-        let sets = generate(&scene, 256, 1);
+        let sets = generate(&scene, sweep_size(), 1);
         // One tree for every variant (see frustum_sweep).
         let tr = PacketTracer::build(scene.world.geometry.clone(), isa).unwrap();
         let subjects: Vec<Subject> = variants
@@ -50,8 +63,9 @@ fn hybrid_sweep() {
             .collect();
         let rows = measure(name, &sets, &subjects, 9, 1);
         println!(
-            "hybrid sweep, {name}, {}: Mrays/s (lane occupancy) per (node, leaf) switch",
-            isa.name()
+            "hybrid sweep, {name}, {}, {}²: Mrays/s (lane occupancy) per (node, leaf) switch",
+            isa.name(),
+            sweep_size()
         );
         for set in &sets {
             let line: Vec<String> = rows
