@@ -247,11 +247,8 @@ fn ties_resolve_to_the_smaller_primitive_everywhere() {
     }
 }
 
-/// Rays leaving points exactly on a wall (x = 0) must not hit the wall itself: the SIMD leaf
-/// keeps the conservative-t rule. Negative control: the same kernel without the rule reports
-/// self-hits, and the comparison with obvhs catches it.
-#[test]
-fn leaf_keeps_the_conservative_t_rule() {
+/// A 2.4 × 2.4 wall in the plane x = 0, 72 triangles.
+fn wall() -> (Vec<Triangle>, std::sync::Arc<Geometry>) {
     let mut tris = vec![];
     for i in 0..6 {
         for j in 0..6 {
@@ -270,6 +267,70 @@ fn leaf_keeps_the_conservative_t_rule() {
         triangles: tris.clone(),
         spheres: vec![],
     });
+    (tris, g)
+}
+
+/// Rays that start a hair behind the wall (x = −10⁻⁸) meet it at a t inside the f32 test's
+/// error bound, which only t in f64 settles: a real hit, unless the ray's tmax ends before
+/// it, or ends within rounding of it. The occlusion kernels (packet and single-ray) settle
+/// such lanes with the scalar test's f64 step alone, the closest-hit ones with the whole scalar
+/// test; all must agree with obvhs on both outcomes, and the rays are chosen so that both
+/// occur. An occlusion kernel whose f64 step ignored tmax fails here, and so does one that
+/// never finds these hits.
+#[test]
+fn near_hits_settled_in_f64_keep_tmax() {
+    let (tris, g) = wall();
+    let base = ObvhsTracer::build(g.clone());
+    let mut packets = vec![];
+    let (mut real, mut cut) = (0, 0);
+    for i in 0..60 {
+        let mut p = RayPacket::default();
+        for lane in 0..LANES {
+            let k = i * LANES + lane;
+            let t = &tris[k % tris.len()];
+            let (b1, b2) = ((k % 43) as f32 / 97.0, (k % 31) as f32 / 71.0);
+            let behind = [1e-8f32, 3e-8, 1e-7][k % 3];
+            let o = t.point(b1, b2) - Vec3::new(behind, 0.0, 0.0);
+            let a = k as f32 * 0.0031;
+            let d = Vec3::new(0.3 + 0.2 * a.sin(), 0.6 * a.cos(), -0.75).normalize();
+            // t to the plane, in f64; tmax after it, or just before it: by less than the
+            // f32 test's rounding of t, so f32 alone may place the hit on either side.
+            let t_plane = (behind as f64 / d.x as f64) as f32;
+            let tmax = match k % 6 {
+                5 => t_plane * 2.0,
+                j => t_plane * (1.0 - [1e-6, 1e-5, 1e-4, 1e-3, 1e-2][j]),
+            };
+            let ray = Ray::new(o, d, tmax);
+            match base.intersect(&ray) {
+                Some(_) => real += 1,
+                None if base.intersect(&Ray::new(o, d, f32::INFINITY)).is_some() => cut += 1,
+                None => {}
+            }
+            p.set(lane, &ray);
+        }
+        packets.push(p);
+    }
+    assert!(
+        real > 100 && cut > 100,
+        "real near hits {real}, cut by tmax {cut}"
+    );
+    for isa in Isa::available() {
+        let tr = PacketTracer::build(g.clone(), isa).unwrap();
+        let mut tally = Tally::default();
+        for p in &packets {
+            check_closest(&base, &tr, p, u16::MAX, &mut tally);
+            check_occluded(&base, &tr, p, u16::MAX);
+        }
+        assert_eq!(tally.hits, real, "{isa:?}");
+    }
+}
+
+/// Rays leaving points exactly on a wall (x = 0) must not hit the wall itself: the SIMD leaf
+/// keeps the conservative-t rule. Negative control: the same kernel without the rule reports
+/// self-hits, and the comparison with obvhs catches it.
+#[test]
+fn leaf_keeps_the_conservative_t_rule() {
+    let (tris, g) = wall();
     let base = ObvhsTracer::build(g.clone());
     let mut packets = vec![];
     for i in 0..80 {

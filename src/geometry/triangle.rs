@@ -251,7 +251,7 @@ impl Triangle {
     /// exact in f64), kept only if it exceeds the f64 form of the pbrt-v4 §6.8.7 bound and
     /// stays positive in f32. A ray starting exactly on the triangle's plane gets t = 0 up to
     /// ~1e-16 here and is rejected; a real hit 1e-6 away is kept.
-    fn provable_t_f64(&self, ray: &Ray, wr: &WatertightRay) -> Option<f32> {
+    pub(crate) fn provable_t_f64(&self, ray: &Ray, wr: &WatertightRay) -> Option<f32> {
         let o = ray.origin.as_dvec3();
         let d = ray.dir.as_dvec3().to_array();
         let (kx, ky, kz) = (wr.kx, wr.ky, wr.kz);

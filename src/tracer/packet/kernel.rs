@@ -740,11 +740,12 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                     cand &= cand - 1;
                     let s = p.sheared::<ORIGIN>(blk, slot);
                     let prim = blk.prim[slot];
-                    let (hit, mut rest) =
+                    let leaf::Tested { hit, exact, t_f64 } =
                         leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
                     if hit != 0 {
                         best.offer::<L::V>(hit, &out, prim);
                     }
+                    let mut rest = exact | t_f64;
                     if rest != 0 {
                         let mut tmv = [0.0; WIDTH];
                         tm.store(&mut tmv);
@@ -855,16 +856,28 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
                         cand &= cand - 1;
                         let s = p.sheared::<ORIGIN>(blk, slot);
                         let prim = blk.prim[slot];
-                        let (mut occ, mut rest) =
-                            leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
-                        while rest != 0 {
-                            let l = rest.trailing_zeros() as usize;
-                            rest &= rest - 1;
+                        let leaf::Tested {
+                            hit: mut occ,
+                            mut exact,
+                            mut t_f64,
+                        } = leaf::watertight::<L::V, WIDTH, FAULT>(&s, m, tm, &mut out);
+                        let tri = &g.triangles[prim as usize];
+                        while exact != 0 {
+                            let l = exact.trailing_zeros() as usize;
+                            exact &= exact - 1;
                             let r = p.ray1(rays, l);
-                            if g.triangles[prim as usize]
+                            if tri
                                 .intersect(&r.ray, &r.wr)
                                 .is_some_and(|h| h.t < r.ray.tmax)
                             {
+                                occ |= 1 << l;
+                            }
+                        }
+                        while t_f64 != 0 {
+                            let l = t_f64.trailing_zeros() as usize;
+                            t_f64 &= t_f64 - 1;
+                            let r = p.ray1(rays, l);
+                            if leaf::f64_t(tri, &r, r.ray.tmax).is_some() {
                                 occ |= 1 << l;
                             }
                         }

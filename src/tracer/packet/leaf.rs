@@ -4,7 +4,9 @@
 //! association), so t and the barycentrics are bit-identical to the scalar test; lanes with an
 //! exactly-zero edge function, and lanes whose t lies within the conservative-t error bound
 //! (see [`crate::geometry::triangle::conservative_t_bound`]), are returned to the caller, which
-//! settles them with the scalar test (f64 there).
+//! settles them: the first with the whole scalar test (its edge functions redone in f64); the
+//! second, for occlusion, with the scalar test's last step alone, t in f64 ([`f64_t`]), since
+//! every f32 value before that step is the scalar test's (a closest hit runs the whole test).
 
 use super::build::Block;
 use super::{Best, FAULT_NO_T_BOUND, Ray1};
@@ -23,15 +25,26 @@ pub struct Sheared<V> {
 /// Per lane (t, b1, b2).
 pub type Out<const N: usize> = [[f32; N]; 3];
 
-/// The test on lanes `m` against per-lane `tmax`: returns (hit lanes, lanes for the scalar test).
-/// Hit lanes have (t, b1, b2) in `out`, with 0 < t < tmax.
+/// What [`watertight`] decided, per lane.
+pub struct Tested {
+    /// Hits, with (t, b1, b2) in `out` and 0 < t < tmax.
+    pub hit: u32,
+    /// Lanes with an exactly-zero edge function: the whole scalar test decides them.
+    pub exact: u32,
+    /// Lanes whose t is within the error bound: the scalar test's last step, t in f64,
+    /// decides them ([`f64_t`] for occlusion; a closest hit, which needs the barycentrics
+    /// too, runs the whole scalar test).
+    pub t_f64: u32,
+}
+
+/// The test on lanes `m` against per-lane `tmax`.
 #[inline(always)]
 pub fn watertight<V: Vector<N>, const N: usize, const FAULT: u32>(
     s: &Sheared<V>,
     m: u32,
     tmax: V,
     out: &mut Out<N>,
-) -> (u32, u32) {
+) -> Tested {
     let ([ax, bx, cx], [ay, by, cy], [az, bz, cz]) = (s.x, s.y, s.z);
     let u = cx.mul(by).sub(cy.mul(bx));
     let v = ax.mul(cy).sub(ay.mul(cx));
@@ -87,7 +100,21 @@ pub fn watertight<V: Vector<N>, const N: usize, const FAULT: u32>(
             w.mul(inv).store(&mut out[2]);
         }
     }
-    (hit, edge0 | unsure)
+    Tested {
+        hit,
+        exact: edge0,
+        t_f64: unsure,
+    }
+}
+
+/// The scalar test's answer for a lane [`watertight`] left to t in f64 (`Tested::t_f64`): its
+/// f32 values up to there are [`Triangle::intersect`]'s, so only that test's last step remains
+/// (the same t, or no hit, as the whole test). Used for occlusion, where shadow rays leaving
+/// walls with no error along their normal met it at every wall: redoing the whole test was
+/// 3 % of a cornell `light` pass (docs/tracer.md, stop 36).
+#[inline(always)]
+pub fn f64_t(tri: &Triangle, r: &Ray1, tmax: f32) -> Option<f32> {
+    tri.provable_t_f64(&r.ray, &r.wr).filter(|&t| t < tmax)
 }
 
 #[inline(always)]
@@ -143,13 +170,17 @@ pub fn block_closest<W: Vector<NARROW>, const FAULT: u32>(
     let s = block_sheared::<W>(blk, r);
     let tmax = best.test_tmax();
     let mut out = [[0.0; NARROW]; 3];
-    let (mut hit, mut rest) =
-        watertight::<W, NARROW, FAULT>(&s, (1 << count) - 1, W::splat(tmax), &mut out);
+    let Tested {
+        mut hit,
+        exact,
+        t_f64,
+    } = watertight::<W, NARROW, FAULT>(&s, (1 << count) - 1, W::splat(tmax), &mut out);
     while hit != 0 {
         let l = hit.trailing_zeros() as usize;
         hit &= hit - 1;
         best.offer(out[0][l], blk.prim[l], out[1][l], out[2][l]);
     }
+    let mut rest = exact | t_f64;
     while rest != 0 {
         let l = rest.trailing_zeros() as usize;
         rest &= rest - 1;
@@ -171,15 +202,25 @@ pub fn block_any<W: Vector<NARROW>, const FAULT: u32>(
     let s = block_sheared::<W>(blk, r);
     let tmax = r.ray.tmax;
     let mut out = [[0.0; NARROW]; 3];
-    let (hit, mut rest) =
-        watertight::<W, NARROW, FAULT>(&s, (1 << count) - 1, W::splat(tmax), &mut out);
+    let Tested {
+        hit,
+        mut exact,
+        mut t_f64,
+    } = watertight::<W, NARROW, FAULT>(&s, (1 << count) - 1, W::splat(tmax), &mut out);
     if hit != 0 {
         return true;
     }
-    while rest != 0 {
-        let l = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
+    while exact != 0 {
+        let l = exact.trailing_zeros() as usize;
+        exact &= exact - 1;
         if scalar(&tris[blk.prim[l] as usize], r, tmax).is_some_and(|h| h.0 < tmax) {
+            return true;
+        }
+    }
+    while t_f64 != 0 {
+        let l = t_f64.trailing_zeros() as usize;
+        t_f64 &= t_f64 - 1;
+        if f64_t(&tris[blk.prim[l] as usize], r, tmax).is_some() {
             return true;
         }
     }
