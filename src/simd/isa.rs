@@ -70,8 +70,12 @@ impl Isa {
             })?;
         if !isa.supported() {
             let have: Vec<_> = Isa::available().iter().map(|i| i.name()).collect();
+            let needs = match isa {
+                Isa::Avx512 => " (it needs avx512f and avx512dq)",
+                _ => "",
+            };
             return Err(Error::Backend(format!(
-                "ISA `{s}` is not supported by this CPU (available: {})",
+                "ISA `{s}` is not supported by this CPU{needs} (available: {})",
                 have.join(", ")
             )));
         }
