@@ -36,7 +36,6 @@ fn scene(name: &str) -> Option<PreparedScene> {
     }
 }
 
-/// The hybrid-switch sweep (see the module docs).
 /// The hybrid sweep's image size: `DIBENCH_SWEEP_SIZE`, else 256.
 fn sweep_size() -> u32 {
     match std::env::var("DIBENCH_SWEEP_SIZE") {
@@ -49,12 +48,14 @@ fn sweep_size() -> u32 {
     }
 }
 
+/// The hybrid-switch sweep (see the module docs).
 fn hybrid_sweep() {
     let variants = [(0, 0), (4, 2), (6, 3), (8, 3), (8, 4), (10, 4), (17, 17)];
     let isa = Isa::available()[0];
+    let size = sweep_size();
     for name in ["bunny", "dragon"] {
         let Some(scene) = scene(name) else { continue };
-        let sets = generate(&scene, sweep_size(), 1);
+        let sets = generate(&scene, size, 1);
         // One tree for every variant (see frustum_sweep).
         let tr = PacketTracer::build(scene.world.geometry.clone(), isa).unwrap();
         let subjects: Vec<Subject> = variants
@@ -65,7 +66,7 @@ fn hybrid_sweep() {
         println!(
             "hybrid sweep, {name}, {}, {}²: Mrays/s (lane occupancy) per (node, leaf) switch",
             isa.name(),
-            sweep_size()
+            size
         );
         for set in &sets {
             let line: Vec<String> = rows
