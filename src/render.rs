@@ -13,11 +13,12 @@ use crate::geometry::triangle::Triangle;
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
 use crate::sampling::generator::MAX_DIMENSIONS;
 use crate::sampling::stream::name_id;
-use crate::sampling::{Dims, GENERATORS, LaneValues, SampleGenerator, SampleKey, Setup};
+use crate::sampling::{GENERATORS, LaneValues, PacketDims, SampleGenerator, SampleKey, Setup};
 use crate::scene::Camera;
 use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector};
 use crate::strategy::{
-    EmissionProbe, Estimator, PassPoints, Probes, ShadingLanes, ShadingPoint, Strategy,
+    EmissionProbe, Estimator, PassPoints, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
+    Strategy,
 };
 use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
 use glam::Vec3;
@@ -43,7 +44,8 @@ pub struct Renderer<'a> {
 /// (rayon's `for_each_init`): 2 KiB of sample values are not cleared and copied per tile.
 struct CameraTile<'a> {
     radiance: [Vec3; LANES],
-    points: [Option<ShadingPoint<'a>>; LANES],
+    /// The shading points, as points and in lanes (the shading kernel writes the lanes).
+    packet: ShadingPacket<'a>,
     values: LaneValues,
 }
 
@@ -51,7 +53,7 @@ impl CameraTile<'_> {
     fn new() -> Self {
         CameraTile {
             radiance: [Vec3::ZERO; LANES],
-            points: [None; LANES],
+            packet: ShadingPacket::default(),
             values: [[0.0; LANES]; MAX_DIMENSIONS],
         }
     }
@@ -66,7 +68,8 @@ struct TileScratch {
     cam: RayPacket,
     hits: HitPacket,
     lanes: HitLanes,
-    shading: ShadingOut,
+    /// The hit points' error bounds (the points and their geometry go to the tile).
+    p_error: Soa3,
     /// The shading phase's shadow and emission packets and the emission rays' hits.
     shadow: RayPacket,
     emit: RayPacket,
@@ -174,7 +177,7 @@ impl<'a> Renderer<'a> {
                 points: vec![None; (layout.width * layout.height) as usize],
             };
             for (t, tile) in tiles.iter().enumerate() {
-                for (lane, p) in tile.points.iter().enumerate() {
+                for (lane, p) in tile.packet.points.iter().enumerate() {
                     if let Some((x, y)) = layout.lane_pixel(t, lane) {
                         pass.points[(y * layout.width + x) as usize] = *p;
                     }
@@ -228,7 +231,8 @@ impl<'a> Renderer<'a> {
         let world = &scene.world;
         let (w, h) = (shape.width, shape.height);
         out.radiance = [Vec3::ZERO; LANES];
-        out.points = [None; LANES];
+        out.packet.points = [None; LANES];
+        out.packet.mask = 0;
         let mut active: LaneMask = 0;
         let mut pixels = [u32::MAX; LANES];
         let mut px = PixelLanes::default();
@@ -253,7 +257,7 @@ impl<'a> Renderer<'a> {
             cam,
             hits,
             lanes: g,
-            shading,
+            p_error,
             ..
         } = scratch;
         simd::run(
@@ -313,8 +317,17 @@ impl<'a> Renderer<'a> {
         if hit_mask == 0 {
             return;
         }
-        simd::run(self.isa, ShadingKernel(g, cam, shading));
-        let ShadingOut { p, p_error, geo } = shading;
+        let ShadingPacket { points, p, geo, .. } = &mut out.packet;
+        simd::run(
+            self.isa,
+            ShadingKernel {
+                hits: g,
+                cam,
+                p,
+                p_error,
+                geo,
+            },
+        );
         for (lane, &pixel) in pixels.iter().enumerate() {
             if hit_mask & (1 << lane) == 0 {
                 continue;
@@ -336,19 +349,19 @@ impl<'a> Renderer<'a> {
             let mut sp =
                 ShadingPoint::from_lanes(geo, lane, p, &world.materials[material as usize]);
             sp.pixel = pixel;
-            out.points[lane] = Some(sp);
+            points[lane] = Some(sp);
         }
+        out.packet.mask = hit_mask;
     }
 
     /// The estimator's probes for the tile's points, traced as packets.
     fn shading_phase(&self, tile: &CameraTile, scratch: &mut TileScratch) -> [Vec3; LANES] {
         let scene = self.scene;
         let mut radiance = tile.radiance;
-        let mut dims: [Dims; LANES] =
-            std::array::from_fn(|lane| Dims::lane(&tile.values, lane, 2, self.dims));
+        let mut dims = PacketDims::new(&tile.values, 2, self.dims);
         let mut probes = [Probes::default(); LANES];
         self.estimator
-            .sample_packet(&tile.points, &mut dims, &mut probes);
+            .sample_packet(&tile.packet, &mut dims, &mut probes);
 
         let TileScratch {
             shadow,
@@ -359,7 +372,7 @@ impl<'a> Renderer<'a> {
         let mut shadow_mask: LaneMask = 0;
         let mut emit_mask: LaneMask = 0;
         for (lane, p) in probes.iter().enumerate() {
-            if tile.points[lane].is_none() {
+            if tile.packet.mask >> lane & 1 == 0 {
                 continue;
             }
             if let Some(s) = p.shadow {
@@ -402,13 +415,14 @@ impl<'a> Renderer<'a> {
                     .add_env_radiance(self.isa, &dirs, escaped, &mut env);
                 env_weight =
                     self.estimator()
-                        .env_weight_packet(&tile.points, &probes, &dirs, escaped);
+                        .env_weight_packet(&tile.packet, &probes, &dirs, escaped);
             }
             // The emitting surfaces the rest found, weighted over lanes.
             let mut surfaces: [Option<SurfaceHit>; LANES] = [None; LANES];
             let mut le = [Vec3::ZERO; LANES];
             for lane in 0..LANES {
-                let (Some(probe), Some(_)) = (probes[lane].emission, &tile.points[lane]) else {
+                let (Some(probe), Some(_)) = (probes[lane].emission, &tile.packet.points[lane])
+                else {
                     continue;
                 };
                 match ehits.get(lane) {
@@ -424,7 +438,7 @@ impl<'a> Renderer<'a> {
             if surfaces.iter().any(Option::is_some) {
                 let w = self
                     .estimator()
-                    .emission_weight_packet(&tile.points, &probes, &surfaces);
+                    .emission_weight_packet(&tile.packet, &probes, &surfaces);
                 for lane in 0..LANES {
                     if let (Some(probe), Some(_)) = (probes[lane].emission, surfaces[lane]) {
                         radiance[lane] += probe.weight * le[lane] * w[lane];
@@ -510,23 +524,21 @@ struct HitLanes {
     given: u32,
 }
 
-/// What [`ShadingKernel`] computes for a tile's hits: points, their error bounds and their
-/// shading geometry, per lane.
-#[derive(Default)]
-struct ShadingOut {
-    p: Soa3,
-    p_error: Soa3,
-    geo: ShadingLanes,
+/// Hit points, their error bounds and their shading geometry over lanes, written into the
+/// tile's shading packet and the worker's scratch.
+struct ShadingKernel<'a> {
+    hits: &'a HitLanes,
+    cam: &'a RayPacket,
+    p: &'a mut Soa3,
+    p_error: &'a mut Soa3,
+    geo: &'a mut ShadingLanes,
 }
-
-/// Hit points and their shading geometry over lanes, written into the worker's scratch.
-struct ShadingKernel<'a>(&'a HitLanes, &'a RayPacket, &'a mut ShadingOut);
 
 impl simd::Kernel for ShadingKernel<'_> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
-        let (g, cam, out) = (self.0, self.1, self.2);
+        let (g, cam) = (self.hits, self.cam);
         let v = [
             V3::<L::V>::load(&g.v[0]),
             V3::load(&g.v[1]),
@@ -540,9 +552,9 @@ impl simd::Kernel for ShadingKernel<'_> {
             y: L::V::load(&cam.dy),
             z: L::V::load(&cam.dz),
         };
-        ShadingLanes::compute(p, p_error, V3::load(&g.ng), dir, &mut out.geo);
-        p.store(&mut out.p);
-        p_error.store(&mut out.p_error);
+        ShadingLanes::compute(p, p_error, V3::load(&g.ng), dir, self.geo);
+        p.store(self.p);
+        p_error.store(self.p_error);
     }
 }
 
@@ -617,7 +629,7 @@ mod tests {
             let camera = &scene.scene.camera;
             let (w, h) = (shape.width, shape.height);
             out.radiance = [Vec3::ZERO; LANES];
-            out.points = [None; LANES];
+            let mut points = [None; LANES];
             let mut cam = RayPacket::default();
             let mut active: LaneMask = 0;
             let mut pixels = [u32::MAX; LANES];
@@ -673,13 +685,15 @@ mod tests {
                     &scene.world.materials[surf.material as usize],
                 );
                 sp.pixel = pixel;
-                out.points[lane] = Some(sp);
+                points[lane] = Some(sp);
             }
+            out.packet = ShadingPacket::from_points(points);
         }
     }
 
     /// Every tile's camera phase over lanes equals the lane-by-lane one bit for bit (points,
-    /// frames, offset origins, what the camera sees directly), on every ISA, in scenes with
+    /// frames, offset origins, what the camera sees directly, and the packet's lanes of the
+    /// points: what estimators written over lanes read), on every ISA, in scenes with
     /// triangles, spheres, emitters seen by the camera and an environment, with partial tiles.
     #[test]
     fn camera_phase_matches_lane_by_lane() {
@@ -692,18 +706,30 @@ mod tests {
             let strategy = crate::strategy::reference_strategy(&scene, Integrand::DIRECT).unwrap();
             let mut r = Renderer::new(&scene, strategy.as_ref(), 3).unwrap();
             let layout = TileLayout::new(30, 22);
-            // One scratch for every tile, ISA and pass, as a worker reuses it.
+            // One scratch and one tile for every tile, ISA and pass, as a worker reuses them.
             let mut scratch = TileScratch::default();
+            let mut got = CameraTile::new();
             for isa in Isa::available() {
                 r.isa = isa;
                 for pass in [0, 7] {
                     for t in 0..layout.tile_count() {
-                        let (mut got, mut want) = (CameraTile::new(), CameraTile::new());
+                        let mut want = CameraTile::new();
                         r.camera_phase(&layout, t, pass, &mut got, &mut scratch);
                         r.camera_phase_lane_by_lane(&layout, t, pass, &mut want);
-                        let text = |c: &CameraTile| format!("{:?} {:?}", c.radiance, c.points);
+                        let text = |c: &CameraTile| {
+                            let k = &c.packet;
+                            let g = &k.geo;
+                            let lanes: Vec<_> = (0..LANES)
+                                .filter(|l| k.mask >> l & 1 != 0)
+                                .map(|l| {
+                                    let f = [&k.p, &g.n, &g.s, &g.t, &g.wo, &g.wo_local, &g.origin];
+                                    f.map(|v| v.get(l))
+                                })
+                                .collect();
+                            format!("{:?} {:?} {:b} {lanes:?}", c.radiance, k.points, k.mask)
+                        };
                         assert_eq!(text(&got), text(&want), "{name} {isa:?} tile {t}");
-                        points += want.points.iter().flatten().count();
+                        points += want.packet.points.iter().flatten().count();
                     }
                 }
             }

@@ -8,13 +8,15 @@ use dibench::lights::selector::default_selector;
 use dibench::lights::{LightMethods, MethodOverride};
 use dibench::prepare::{PreparedScene, SurfaceHit};
 use dibench::render::camera_ray;
-use dibench::sampling::Dims;
+use dibench::sampling::generator::MAX_DIMENSIONS;
 use dibench::sampling::stream::SampleStream;
+use dibench::sampling::{Dims, LaneValues, PacketDims};
 use dibench::scene::Scene;
 use dibench::simd::{Isa, Soa3};
 use dibench::strategy::light_sampling::{BoundLights, LightProbe};
-use dibench::strategy::{Probes, ShadingPoint, by_name};
+use dibench::strategy::{Probes, ShadingPacket, ShadingPoint, by_name};
 use dibench::tracer::LANES;
+use glam::Vec3;
 
 /// Scenes with quad, sphere, mesh, point, spot, directional and environment lights, and with
 /// Phong, GGX and principled materials beside Lambertian ones (packets of mixed materials).
@@ -78,11 +80,10 @@ fn scenes() -> Vec<(String, PreparedScene)> {
 const DIMS: usize = 16;
 
 /// Packets of shading points seen through random pixels, with lane 5 of every packet and
-/// every lane whose camera ray misses left empty; and sample values for every lane.
-fn packets(
-    scene: &PreparedScene,
-    count: usize,
-) -> Vec<([Option<ShadingPoint<'_>>; LANES], Vec<f32>)> {
+/// every lane whose camera ray misses left empty; and sample values for every lane. The lanes
+/// without a point hold a made-up point, as a renderer's reused packet holds an earlier
+/// tile's: nothing may read them.
+fn packets(scene: &PreparedScene, count: usize) -> Vec<(ShadingPacket<'_>, LaneValues)> {
     let (w, h) = (scene.scene.width, scene.scene.height);
     let mut rng = SampleStream::new(7, 0x1a_4e5, 0, 0);
     let mut f = move || rng.next_1d();
@@ -104,13 +105,46 @@ fn packets(
                     &scene.world.materials[s.material as usize],
                 ))
             });
-            (points, (0..LANES * DIMS).map(|_| f()).collect())
+            let mut packet = ShadingPacket::from_points(points);
+            for lane in (0..LANES).filter(|l| packet.mask >> l & 1 == 0) {
+                let g = &mut packet.geo;
+                let p = Vec3::new(123.0, -45.0, 6.0);
+                for (to, v) in [
+                    (&mut packet.p, p),
+                    (&mut g.n, Vec3::Z),
+                    (&mut g.s, Vec3::X),
+                    (&mut g.t, Vec3::Y),
+                    (&mut g.wo, Vec3::new(0.6, 0.0, 0.8)),
+                    (&mut g.wo_local, Vec3::new(0.6, 0.0, 0.8)),
+                    (&mut g.origin, p),
+                ] {
+                    to.set(lane, v);
+                }
+            }
+            let mut values: LaneValues = [[0.0; LANES]; MAX_DIMENSIONS];
+            for lane in 0..LANES {
+                for row in values.iter_mut().take(DIMS) {
+                    row[lane] = f();
+                }
+            }
+            (packet, values)
         })
         .collect()
 }
 
-fn dims(values: &[f32]) -> [Dims<'_>; LANES] {
-    std::array::from_fn(|lane| Dims::new(&values[lane * DIMS..(lane + 1) * DIMS]))
+fn dims(values: &LaneValues) -> [Dims<'_>; LANES] {
+    std::array::from_fn(|lane| Dims::lane(values, lane, 0, DIMS))
+}
+
+/// The dimensions the lanes with a point read, one count per lane, beside the count the
+/// packet read; every count must be the packet's.
+fn dimensions_read(packet: &ShadingPacket, u: &[Dims; LANES], pu: &PacketDims) -> Vec<usize> {
+    let mut v: Vec<usize> = (0..LANES)
+        .filter(|l| packet.mask >> l & 1 != 0)
+        .map(|l| u[l].used())
+        .collect();
+    v.push(DIMS - pu.remaining());
+    v
 }
 
 /// Debug text prints every float by its shortest round trip, so equal text is equal bits.
@@ -144,7 +178,8 @@ fn light_probes_over_lanes_are_the_scalar_ones() {
             let mut bound = BoundLights::bind(&view, default_selector(), methods).unwrap();
             for isa in Isa::available() {
                 bound.isa = isa;
-                for (points, values) in &packets {
+                for (packet, values) in &packets {
+                    let points = &packet.points;
                     let mut want: [Option<LightProbe>; LANES] = [None; LANES];
                     let mut u = dims(values);
                     for lane in 0..LANES {
@@ -152,14 +187,13 @@ fn light_probes_over_lanes_are_the_scalar_ones() {
                             want[lane] = bound.probe(sp, &mut u[lane]);
                         }
                     }
-                    let next_want: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
                     let mut got: [Option<LightProbe>; LANES] = [None; LANES];
-                    let mut u = dims(values);
-                    bound.probe_packet(points, &mut u, &mut got);
-                    let next_got: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
-                    assert_eq!(
-                        next_got, next_want,
-                        "{name} {strategy} {isa:?}: dimensions read"
+                    let mut pu = PacketDims::new(values, 0, DIMS);
+                    bound.probe_packet(packet, &mut pu, &mut got);
+                    let read = dimensions_read(packet, &u, &pu);
+                    assert!(
+                        read.iter().all(|&n| n == read[0]),
+                        "{name} {strategy} {isa:?}: dimensions read {read:?}"
                     );
                     for lane in 0..LANES {
                         assert!(
@@ -199,7 +233,8 @@ fn estimators_packets_are_their_samples() {
             let Ok(est) = s.bind(scene.view(s.integrand())) else {
                 continue;
             };
-            for (points, values) in &packets {
+            for (packet, values) in &packets {
+                let points = &packet.points;
                 let mut want = [Probes::default(); LANES];
                 let mut u = dims(values);
                 for lane in 0..LANES {
@@ -207,12 +242,14 @@ fn estimators_packets_are_their_samples() {
                         want[lane] = est.sample(sp, &mut u[lane]);
                     }
                 }
-                let next_want: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
                 let mut got = [Probes::default(); LANES];
-                let mut u = dims(values);
-                est.sample_packet(points, &mut u, &mut got);
-                let next_got: Vec<f32> = u.iter_mut().map(|d| d.get_1d()).collect();
-                assert_eq!(next_got, next_want, "{name} {strategy}: dimensions read");
+                let mut pu = PacketDims::new(values, 0, DIMS);
+                est.sample_packet(packet, &mut pu, &mut got);
+                let read = dimensions_read(packet, &u, &pu);
+                assert!(
+                    read.iter().all(|&n| n == read[0]),
+                    "{name} {strategy}: dimensions read {read:?}"
+                );
                 for lane in 0..LANES {
                     assert!(
                         same(&got[lane], &want[lane]),
@@ -252,10 +289,10 @@ fn env_weights_over_lanes_are_the_scalar_ones() {
             let Ok(est) = s.bind(scene.view(s.integrand())) else {
                 continue;
             };
-            for (points, values) in &packets {
+            for (packet, values) in &packets {
+                let points = &packet.points;
                 let mut probes = [Probes::default(); LANES];
-                let mut u = dims(values);
-                est.sample_packet(points, &mut u, &mut probes);
+                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut probes);
                 let mut dirs = Soa3::default();
                 let mut mask = 0u32;
                 for lane in 0..LANES {
@@ -264,7 +301,7 @@ fn env_weights_over_lanes_are_the_scalar_ones() {
                         mask |= 1 << lane;
                     }
                 }
-                let got = est.env_weight_packet(points, &probes, &dirs, mask);
+                let got = est.env_weight_packet(packet, &probes, &dirs, mask);
                 for lane in 0..LANES {
                     if mask >> lane & 1 == 0 {
                         continue;
@@ -304,10 +341,10 @@ fn emission_weights_over_lanes_are_the_scalar_ones() {
             let Ok(est) = s.bind(scene.view(s.integrand())) else {
                 continue;
             };
-            for (points, values) in &packets {
+            for (packet, values) in &packets {
+                let points = &packet.points;
                 let mut probes = [Probes::default(); LANES];
-                let mut u = dims(values);
-                est.sample_packet(points, &mut u, &mut probes);
+                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut probes);
                 let hits: [Option<SurfaceHit>; LANES] = std::array::from_fn(|lane| {
                     let e = probes[lane]
                         .emission
@@ -317,7 +354,7 @@ fn emission_weights_over_lanes_are_the_scalar_ones() {
                     scene.world.prim_emitter[hit.prim as usize]?;
                     Some(scene.world.surface(&e.ray, &hit))
                 });
-                let got = est.emission_weight_packet(points, &probes, &hits);
+                let got = est.emission_weight_packet(packet, &probes, &hits);
                 for lane in 0..LANES {
                     let Some(hit) = &hits[lane] else { continue };
                     let (sp, e) = (points[lane].as_ref().unwrap(), &probes[lane].emission);

@@ -255,6 +255,62 @@ impl<'a> Dims<'a> {
     }
 }
 
+/// A packet's dimensions, read in layout order for all 16 lanes at once: an estimator written
+/// over lanes takes each dimension as one row (`values[d]`, lane l at `[l]`), where a
+/// lane-by-lane estimator reads its own lane through [`Self::lane`]. Reading past the end is
+/// the programming error [`Dims`] reports.
+#[derive(Debug)]
+pub struct PacketDims<'a> {
+    values: &'a LaneValues,
+    next: usize,
+    end: usize,
+}
+
+impl<'a> PacketDims<'a> {
+    /// Dimensions `from..to` of a packet's samples.
+    pub fn new(values: &'a LaneValues, from: usize, to: usize) -> Self {
+        assert!(
+            from <= to && to <= MAX_DIMENSIONS,
+            "dimensions {from}..{to} of a packet"
+        );
+        PacketDims {
+            values,
+            next: from,
+            end: to,
+        }
+    }
+
+    /// The next `N` dimensions of every lane, one row each.
+    #[inline(always)]
+    pub fn take<const N: usize>(&mut self) -> [&'a [f32; WIDTH]; N] {
+        let (values, next) = (self.values, self.next);
+        self.skip(N);
+        std::array::from_fn(|k| &values[next + k])
+    }
+
+    /// Lane `lane`'s dimensions from here to the end, for a part that reads lane by lane;
+    /// reading them does not move this cursor (see [`Self::skip`]).
+    pub fn lane(&self, lane: usize) -> Dims<'a> {
+        Dims::lane(self.values, lane, self.next, self.end)
+    }
+
+    /// Moves past `n` dimensions that the lanes read on their own ([`Self::lane`]).
+    pub fn skip(&mut self, n: usize) {
+        if self.next + n > self.end {
+            panic!(
+                "a strategy read {n} more dimensions of a packet with {} left: its layout() must declare every dimension it draws",
+                self.end - self.next
+            );
+        }
+        self.next += n;
+    }
+
+    /// How many dimensions are left.
+    pub fn remaining(&self) -> usize {
+        self.end - self.next
+    }
+}
+
 /// Asserts that a generator's packet fill gives each lane its single-sample numbers on every
 /// ISA, bit for bit: `fill(isa, out)` runs the packet kernel in that ISA's context.
 #[cfg(test)]

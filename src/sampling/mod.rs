@@ -9,7 +9,9 @@ pub mod spherical;
 pub mod stream;
 pub mod warp;
 
-pub use generator::{Dimension, Dims, LaneValues, Layout, SampleGenerator, SampleKey, Setup};
+pub use generator::{
+    Dimension, Dims, LaneValues, Layout, PacketDims, SampleGenerator, SampleKey, Setup,
+};
 
 crate::plugin::registry! {
     /// Every sample generator, in listing order; the first is the default.

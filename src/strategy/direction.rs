@@ -3,7 +3,7 @@
 //! mixture, by the strategy's [`BsdfSampling`] part: lobe selection and GGX sampler).
 //! Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
 
-use super::{EmissionProbe, Estimator, Probes, ShadingPoint, Strategy};
+use super::{EmissionProbe, Estimator, Probes, ShadingPacket, ShadingPoint, Strategy};
 use crate::bsdf::{BsdfSample, BsdfSampling, CosineQuery, sample_cosine_lanes};
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
@@ -11,8 +11,8 @@ use crate::sampling::warp::{
     UNIFORM_HEMISPHERE_PDF, cosine_hemisphere_pdf, sample_cosine_hemisphere,
     sample_uniform_hemisphere,
 };
-use crate::sampling::{Dimension, Dims, Layout};
-use crate::simd::Isa;
+use crate::sampling::{Dimension, Dims, Layout, PacketDims};
+use crate::simd::{Isa, WIDTH};
 use crate::tracer::LANES;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -158,32 +158,23 @@ impl Estimator for DirectionEstimator {
     /// [`Self::sample`] for a packet, bit for bit: cosine-hemisphere directions (every lane of
     /// `cosine`, the lanes of cosine-sampled materials for `bsdf`) are drawn and taken to world
     /// space over lanes; f, the pdf and the rest lane by lane.
-    fn sample_packet(
-        &self,
-        points: &[Option<ShadingPoint>; LANES],
-        u: &mut [Dims; LANES],
-        out: &mut [Probes; LANES],
-    ) {
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
+        let points = &packet.points;
         match self.strategy.kind {
             DirectionKind::UniformHemisphere => {
-                for ((p, u), o) in points.iter().zip(u.iter_mut()).zip(out.iter_mut()) {
+                for (lane, (p, o)) in points.iter().zip(out.iter_mut()).enumerate() {
                     if let Some(sp) = p {
-                        *o = self.sample(sp, u);
+                        *o = self.sample(sp, &mut u.lane(lane));
                     }
                 }
+                u.skip(2);
             }
             DirectionKind::CosineHemisphere => {
-                let mut q = CosineQuery::default();
-                let mut mask = 0u32;
-                for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
-                    if let Some(sp) = sp {
-                        q.set(lane, &sp.bsdf.frame, u.get_2d());
-                        mask |= 1 << lane;
-                    }
-                }
-                if mask == 0 {
+                let [u0, u1] = u.take::<2>();
+                if packet.mask == 0 {
                     return;
                 }
+                let q = cosine_query(packet, [u0, u1]);
                 let r = sample_cosine_lanes(self.isa, &q);
                 for (lane, (sp, o)) in points.iter().zip(out.iter_mut()).enumerate() {
                     let Some(sp) = sp else { continue };
@@ -197,7 +188,7 @@ impl Estimator for DirectionEstimator {
             }
             DirectionKind::Bsdf => bsdf_sample_packet(
                 self.isa,
-                points,
+                packet,
                 u,
                 self.strategy.sampling,
                 |lane, sp, s| {
@@ -208,6 +199,18 @@ impl Estimator for DirectionEstimator {
     }
 }
 
+/// What [`sample_cosine_lanes`] needs for the points of `packet`, with sample numbers `u`:
+/// the frames' rows as they are.
+#[inline(always)]
+fn cosine_query(packet: &ShadingPacket, u: [&[f32; WIDTH]; 2]) -> CosineQuery {
+    CosineQuery {
+        s: packet.geo.s,
+        t: packet.geo.t,
+        n: packet.geo.n,
+        u: [*u[0], *u[1]],
+    }
+}
+
 /// `sp.bsdf.sample(u.get_3d(), sampling)` for each lane of a packet, bit for bit, handed to
 /// `emit(lane, point, sample)`: lanes whose material is cosine-sampled draw their directions
 /// over lanes ([`sample_cosine_lanes`]: the lobe drawn by u[2] does not change the direction),
@@ -215,27 +218,30 @@ impl Estimator for DirectionEstimator {
 #[inline(always)]
 pub fn bsdf_sample_packet<'p, 's>(
     isa: Isa,
-    points: &'p [Option<ShadingPoint<'s>>; LANES],
-    u: &mut [Dims; LANES],
+    packet: &'p ShadingPacket<'s>,
+    u: &mut PacketDims,
     sampling: BsdfSampling,
     mut emit: impl FnMut(usize, &'p ShadingPoint<'s>, BsdfSample),
 ) {
-    let mut q = CosineQuery::default();
+    let [u0, u1, u2] = u.take::<3>();
+    let points = &packet.points;
     let mut mask = 0u32;
-    for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
+    for (lane, sp) in points.iter().enumerate() {
         let Some(sp) = sp else { continue };
-        let u = u.get_3d();
         if sp.bsdf.bsdf.is_cosine_sampled() {
-            q.set(lane, &sp.bsdf.frame, [u[0], u[1]]);
             mask |= 1 << lane;
         } else {
-            emit(lane, sp, sp.bsdf.sample(u, sampling));
+            emit(
+                lane,
+                sp,
+                sp.bsdf.sample([u0[lane], u1[lane], u2[lane]], sampling),
+            );
         }
     }
     if mask == 0 {
         return;
     }
-    let r = sample_cosine_lanes(isa, &q);
+    let r = sample_cosine_lanes(isa, &cosine_query(packet, [u0, u1]));
     for (lane, sp) in points.iter().enumerate() {
         let Some(sp) = sp.as_ref().filter(|_| mask >> lane & 1 != 0) else {
             continue;

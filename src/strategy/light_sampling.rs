@@ -3,7 +3,10 @@
 //! `light` uses the lecture's basic samplers; each variant overrides one shape's sampler or
 //! pins the environment's representation and sampler.
 
-use super::{Estimator, Integrand, Probes, ShadingPoint, ShadowProbe, Strategy, env_method_name};
+use super::{
+    Estimator, Integrand, Probes, ShadingLanes, ShadingPacket, ShadingPoint, ShadowProbe, Strategy,
+    env_method_name,
+};
 use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
@@ -16,7 +19,7 @@ use crate::lights::{
 };
 use crate::math::offset_ray_origin_lanes;
 use crate::prepare::SceneView;
-use crate::sampling::{Dimension, Dims, Layout};
+use crate::sampling::{Dimension, Dims, Layout, PacketDims};
 use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, WIDTH};
 use crate::tracer::LANES;
 use glam::Vec3;
@@ -97,13 +100,11 @@ pub struct BoundLights<'s> {
 /// frame, and the light's index.
 pub type LightProbe = (ShadowProbe, LightSample, Vec3, usize);
 
-/// The packet's per-lane inputs to the shadow-ray kernel, beside the light samples.
-#[derive(Default)]
-struct ShadowLanes {
+/// The packet's per-lane inputs to the shadow-ray kernel, beside the light samples: the
+/// selection pmfs and the points' lanes (origins and frames).
+struct ShadowLanes<'a> {
     pmf: [f32; WIDTH],
-    origin: Soa3,
-    s: Soa3,
-    t: Soa3,
+    geo: &'a ShadingLanes,
 }
 
 /// The shadow-ray kernel's results: `valid` lanes have a probe.
@@ -128,7 +129,7 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
     let pdf = V::load(&ls.pdf).mul(V::load(&x.pmf));
     let cos = V3::load(&q.n).dot(wi);
     let mut valid = ls.valid & !cos.le(zero);
-    let origin = V3::load(&x.origin);
+    let origin = V3::load(&x.geo.origin);
     let point = V3::load(&ls.point);
     let normal = V3::load(&ls.normal);
     let facing = zero.le(normal.dot(origin - point));
@@ -145,8 +146,8 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
         dist.mul(V::splat(1.0 - SHADOW_EPSILON)),
     );
     let local = V3 {
-        x: wi.dot(V3::load(&x.s)),
-        y: wi.dot(V3::load(&x.t)),
+        x: wi.dot(V3::load(&x.geo.s)),
+        y: wi.dot(V3::load(&x.geo.t)),
         z: cos,
     };
     let mut out = ShadowRays {
@@ -206,16 +207,16 @@ impl<'s> BoundLights<'s> {
     /// lane. Lanes without a point are left as they are.
     pub fn probe_packet(
         &self,
-        points: &[Option<ShadingPoint>; LANES],
-        u: &mut [Dims; LANES],
+        packet: &ShadingPacket,
+        u: &mut PacketDims,
         out: &mut [Option<LightProbe>; LANES],
     ) {
-        for (o, p) in out.iter_mut().zip(points) {
+        for (o, p) in out.iter_mut().zip(&packet.points) {
             if p.is_some() {
                 *o = None;
             }
         }
-        self.probe_packet_each(points, u, |lane, probe| out[lane] = Some(probe));
+        self.probe_packet_each(packet, u, |lane, probe| out[lane] = Some(probe));
     }
 
     /// [`Self::probe_packet`], handing each lane's probe to `emit` (lane, probe) instead of
@@ -223,39 +224,47 @@ impl<'s> BoundLights<'s> {
     #[inline(always)]
     pub fn probe_packet_each(
         &self,
-        points: &[Option<ShadingPoint>; LANES],
-        u: &mut [Dims; LANES],
+        packet: &ShadingPacket,
+        u: &mut PacketDims,
         mut emit: impl FnMut(usize, LightProbe),
     ) {
-        let mut q = LaneQuery::default();
-        let mut x = ShadowLanes::default();
+        let [u_select, u0, u1, u2] = u.take::<4>();
+        // The points and their sample numbers, as rows (no lane is moved on its own).
+        let q = LaneQuery {
+            p: packet.p,
+            n: packet.geo.n,
+            u: [*u0, *u1, *u2],
+        };
+        let mut x = ShadowLanes {
+            pmf: [0.0; WIDTH],
+            geo: &packet.geo,
+        };
         let mut light = [usize::MAX; LANES];
-        let mut chosen = 0u32;
+        let chosen;
         // One dynamic call per packet, not per lane, where the choice cannot vary (one light).
-        let constant = self.selector.constant();
-        for (lane, (sp, u)) in points.iter().zip(u.iter_mut()).enumerate() {
-            let Some(sp) = sp else { continue };
-            let u_select = u.get_1d();
-            let ul = u.get_3d();
-            let ctx = sp.light_ctx();
-            let Some((i, pmf)) = constant.or_else(|| {
-                self.selector
-                    .sample(&ctx, selection_number(u_select, ul[2]))
-            }) else {
-                continue;
-            };
-            light[lane] = i;
-            x.pmf[lane] = pmf;
-            chosen |= 1 << lane;
-            q.p.set(lane, ctx.p);
-            q.n.set(lane, ctx.n);
-            for (k, &v) in ul.iter().enumerate() {
-                q.u[k][lane] = v;
+        if let Some((i, pmf)) = self.selector.constant() {
+            chosen = packet.mask;
+            light = [i; LANES];
+            x.pmf = [pmf; WIDTH];
+        } else {
+            let mut c = 0u32;
+            let mut rest = packet.mask;
+            while rest != 0 {
+                let lane = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                let Some((i, pmf)) = self
+                    .selector
+                    .sample(&q.ctx(lane), selection_number(u_select[lane], u2[lane]))
+                else {
+                    continue;
+                };
+                light[lane] = i;
+                x.pmf[lane] = pmf;
+                c |= 1 << lane;
             }
-            x.origin.set(lane, sp.origin);
-            x.s.set(lane, sp.bsdf.frame.s);
-            x.t.set(lane, sp.bsdf.frame.t);
+            chosen = c;
         }
+        let points = &packet.points;
         // Lights with a kernel over lanes of different lights (mesh triangles) hand over their
         // records; each such kernel samples all its lanes at once.
         let mut ls = LaneSamples::default();
@@ -292,13 +301,13 @@ impl<'s> BoundLights<'s> {
         let mut rest = chosen & !with_kernel;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
-            let mask = lanes_holding(&light, i);
+            let mask = lanes_holding(&light, i) & chosen;
             rest &= !mask;
             self.lights
                 .get(i)
                 .sample_lanes(self.isa, &q, mask, &self.methods, &mut ls);
         }
-        struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes);
+        struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes<'a>);
         impl simd::Kernel for Kernel<'_> {
             type Out = ShadowRays;
             #[inline(always)]
@@ -473,18 +482,13 @@ impl Estimator for LightEstimator<'_> {
         }
     }
 
-    fn sample_packet(
-        &self,
-        points: &[Option<ShadingPoint>; LANES],
-        u: &mut [Dims; LANES],
-        out: &mut [Probes; LANES],
-    ) {
-        for (o, p) in out.iter_mut().zip(points) {
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
+        for (o, p) in out.iter_mut().zip(&packet.points) {
             if p.is_some() {
                 *o = Probes::default();
             }
         }
         self.0
-            .probe_packet_each(points, u, |lane, (p, ..)| out[lane] = Probes::shadow(p));
+            .probe_packet_each(packet, u, |lane, (p, ..)| out[lane] = Probes::shadow(p));
     }
 }

@@ -8,15 +8,15 @@
 use super::direction::{BSDF_DIMS, bsdf_sample_packet, emission_probe_with};
 use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
 use super::{
-    EmissionProbe, Estimator, Integrand, Probes, ShadingPoint, ShadowProbe, Strategy,
-    env_method_name,
+    EmissionProbe, Estimator, Integrand, Probes, ShadingPacket, ShadingPoint, ShadowProbe,
+    Strategy, env_method_name,
 };
 use crate::bsdf::BsdfSampling;
 use crate::env::EnvMethod;
 use crate::lights::selector::{SelectorType, default_selector};
 use crate::lights::{LightMethods, LightShape, SurfaceLanes};
 use crate::prepare::{SceneView, SurfaceHit};
-use crate::sampling::{Dims, Layout};
+use crate::sampling::{Dims, Layout, PacketDims};
 use crate::simd::Soa3;
 use crate::tracer::LANES;
 
@@ -264,26 +264,22 @@ impl Estimator for MisEstimator<'_> {
         self.finish(sp, light, u)
     }
 
-    fn sample_packet(
-        &self,
-        points: &[Option<ShadingPoint>; LANES],
-        u: &mut [Dims; LANES],
-        out: &mut [Probes; LANES],
-    ) {
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
+        let points = &packet.points;
         for (o, sp) in out.iter_mut().zip(points) {
             if sp.is_some() {
                 o.shadow = None;
             }
         }
         // Each probe weighted as it is made (no packet of full light probes stored and copied).
-        self.lights.probe_packet_each(points, u, |lane, probe| {
+        self.lights.probe_packet_each(packet, u, |lane, probe| {
             if let Some(sp) = &points[lane] {
                 out[lane].shadow = self.weighted(sp, Some(probe));
             }
         });
         bsdf_sample_packet(
             self.lights.isa,
-            points,
+            packet,
             u,
             self.strategy.sampling,
             |lane, sp, bs| {
@@ -300,10 +296,11 @@ impl Estimator for MisEstimator<'_> {
 
     fn emission_weight_packet(
         &self,
-        points: &[Option<ShadingPoint>; LANES],
+        packet: &ShadingPacket,
         probes: &[Probes; LANES],
         hits: &[Option<SurfaceHit>; LANES],
     ) -> [f32; LANES] {
+        let points = &packet.points;
         let mut at = SurfaceLanes::default();
         let mut light = [0u32; LANES];
         let mut mask = 0u32;
@@ -336,12 +333,12 @@ impl Estimator for MisEstimator<'_> {
 
     fn env_weight_packet(
         &self,
-        points: &[Option<ShadingPoint>; LANES],
+        packet: &ShadingPacket,
         probes: &[Probes; LANES],
         dirs: &Soa3,
         mask: u32,
     ) -> [f32; LANES] {
-        let p_light = self.lights.env_pdf_packet(points, dirs, mask);
+        let p_light = self.lights.env_pdf_packet(&packet.points, dirs, mask);
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0

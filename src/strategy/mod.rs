@@ -20,7 +20,7 @@ use crate::geometry::Ray;
 use crate::lights::LightCtx;
 use crate::math::{Frame, offset_ray_origin, offset_ray_origin_lanes};
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
-use crate::sampling::{Dims, Layout};
+use crate::sampling::{Dims, Layout, PacketDims};
 use crate::simd::{Soa3, V3, Vector, WIDTH};
 use crate::tracer::LANES;
 use glam::Vec3;
@@ -137,6 +137,55 @@ impl ShadingLanes {
     }
 }
 
+/// A packet of up to 16 shading points, each both as a [`ShadingPoint`] (for parts that shade
+/// lane by lane) and in lanes (for parts written over lanes, which then move no point in or
+/// out of its struct): in the lanes of `mask`, `p` and `geo` hold what `points` holds there;
+/// other lanes hold finite values that nothing reads.
+#[derive(Clone, Debug)]
+pub struct ShadingPacket<'a> {
+    pub points: [Option<ShadingPoint<'a>>; LANES],
+    /// The points' positions (`ShadingPoint::p`).
+    pub p: Soa3,
+    pub geo: ShadingLanes,
+    /// The lanes that hold a point.
+    pub mask: u32,
+}
+
+impl Default for ShadingPacket<'_> {
+    fn default() -> Self {
+        ShadingPacket {
+            points: [None; LANES],
+            p: Soa3::default(),
+            geo: ShadingLanes::default(),
+            mask: 0,
+        }
+    }
+}
+
+impl<'a> ShadingPacket<'a> {
+    /// The packet of `points`, their lanes gathered from them (a test's or a closed-form
+    /// check's packet; the renderer computes the lanes first and the points from them).
+    pub fn from_points(points: [Option<ShadingPoint<'a>>; LANES]) -> Self {
+        let mut packet = ShadingPacket {
+            points,
+            ..Default::default()
+        };
+        for (lane, sp) in points.iter().enumerate() {
+            let Some(sp) = sp else { continue };
+            packet.mask |= 1 << lane;
+            packet.p.set(lane, sp.p);
+            let g = &mut packet.geo;
+            g.n.set(lane, sp.n);
+            g.s.set(lane, sp.bsdf.frame.s);
+            g.t.set(lane, sp.bsdf.frame.t);
+            g.wo.set(lane, sp.wo);
+            g.wo_local.set(lane, sp.bsdf.wo);
+            g.origin.set(lane, sp.origin);
+        }
+        packet
+    }
+}
+
 /// What one sample asks the tracer. The contribution is `shadow.value` if the shadow segment
 /// is clear, plus `emission.weight · Le · w` for the emitter the emission ray hits first, with
 /// w the estimator's [`Estimator::emission_weight`] (or [`Estimator::env_weight`] if it
@@ -245,19 +294,20 @@ pub trait Estimator: Send + Sync {
 
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes;
 
-    /// The probes of a 16-lane packet of shading points (None: the lane has no point). The
-    /// default shades lane by lane; an estimator written over lanes overrides it.
-    fn sample_packet(
-        &self,
-        points: &[Option<ShadingPoint>; LANES],
-        u: &mut [Dims; LANES],
-        out: &mut [Probes; LANES],
-    ) {
-        for ((p, u), o) in points.iter().zip(u.iter_mut()).zip(out.iter_mut()) {
+    /// The probes of a packet of shading points, reading each lane's dimensions from `u` and
+    /// leaving `u` past the most any lane read (lanes without a point are left as they are). The default shades lane by lane through
+    /// [`Self::sample`]; an estimator written over lanes overrides it, reading whole rows of
+    /// `u` ([`PacketDims::take`]) and the points' lanes ([`ShadingPacket::geo`]).
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
+        let mut used = 0;
+        for (lane, (p, o)) in packet.points.iter().zip(out.iter_mut()).enumerate() {
             if let Some(sp) = p {
-                *o = self.sample(sp, u);
+                let mut d = u.lane(lane);
+                *o = self.sample(sp, &mut d);
+                used = used.max(d.used());
             }
         }
+        u.skip(used);
     }
 
     /// Weight of the emission an emission probe found at `hit` (MIS overrides).
@@ -275,14 +325,14 @@ pub trait Estimator: Send + Sync {
     /// lane by lane unless overridden.
     fn emission_weight_packet(
         &self,
-        points: &[Option<ShadingPoint>; LANES],
+        packet: &ShadingPacket,
         probes: &[Probes; LANES],
         hits: &[Option<SurfaceHit>; LANES],
     ) -> [f32; LANES] {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
             if let (Some(sp), Some(probe), Some(hit)) =
-                (&points[lane], &probes[lane].emission, &hits[lane])
+                (&packet.points[lane], &probes[lane].emission, &hits[lane])
             {
                 *o = self.emission_weight(sp, probe, hit);
             }
@@ -300,7 +350,7 @@ pub trait Estimator: Send + Sync {
     /// outside `mask` are not read.
     fn env_weight_packet(
         &self,
-        points: &[Option<ShadingPoint>; LANES],
+        packet: &ShadingPacket,
         probes: &[Probes; LANES],
         _dirs: &Soa3,
         mask: u32,
@@ -308,7 +358,7 @@ pub trait Estimator: Send + Sync {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0
-                && let (Some(sp), Some(probe)) = (&points[lane], &probes[lane].emission)
+                && let (Some(sp), Some(probe)) = (&packet.points[lane], &probes[lane].emission)
             {
                 *o = self.env_weight(sp, probe);
             }
