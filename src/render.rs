@@ -177,9 +177,9 @@ impl<'a> Renderer<'a> {
                 points: vec![None; (layout.width * layout.height) as usize],
             };
             for (t, tile) in tiles.iter().enumerate() {
-                for (lane, p) in tile.packet.points.iter().enumerate() {
+                for (lane, p) in tile.packet.points() {
                     if let Some((x, y)) = layout.lane_pixel(t, lane) {
-                        pass.points[(y * layout.width + x) as usize] = *p;
+                        pass.points[(y * layout.width + x) as usize] = Some(p);
                     }
                 }
             }
@@ -231,7 +231,6 @@ impl<'a> Renderer<'a> {
         let world = &scene.world;
         let (w, h) = (shape.width, shape.height);
         out.radiance = [Vec3::ZERO; LANES];
-        out.packet.points = [None; LANES];
         out.packet.mask = 0;
         let mut active: LaneMask = 0;
         let mut pixels = [u32::MAX; LANES];
@@ -317,7 +316,13 @@ impl<'a> Renderer<'a> {
         if hit_mask == 0 {
             return;
         }
-        let ShadingPacket { points, p, geo, .. } = &mut out.packet;
+        let ShadingPacket {
+            p,
+            geo,
+            bsdf,
+            pixel: pixel_of,
+            ..
+        } = &mut out.packet;
         simd::run(
             self.isa,
             ShadingKernel {
@@ -346,10 +351,8 @@ impl<'a> Renderer<'a> {
                 };
                 out.radiance[lane] += self.view.emitted(&surf, cam.get(lane).dir);
             }
-            let mut sp =
-                ShadingPoint::from_lanes(geo, lane, p, &world.materials[material as usize]);
-            sp.pixel = pixel;
-            points[lane] = Some(sp);
+            bsdf[lane] = Some(&world.materials[material as usize]);
+            pixel_of[lane] = pixel;
         }
         out.packet.mask = hit_mask;
     }
@@ -421,7 +424,7 @@ impl<'a> Renderer<'a> {
             let mut surfaces: [Option<SurfaceHit>; LANES] = [None; LANES];
             let mut le = [Vec3::ZERO; LANES];
             for lane in 0..LANES {
-                let (Some(probe), Some(_)) = (probes[lane].emission, &tile.packet.points[lane])
+                let Some(probe) = probes[lane].emission.filter(|_| emit_mask >> lane & 1 != 0)
                 else {
                     continue;
                 };
@@ -687,7 +690,7 @@ mod tests {
                 sp.pixel = pixel;
                 points[lane] = Some(sp);
             }
-            out.packet = ShadingPacket::from_points(points);
+            out.packet = ShadingPacket::from_points(&points);
         }
     }
 
@@ -726,10 +729,11 @@ mod tests {
                                     f.map(|v| v.get(l))
                                 })
                                 .collect();
-                            format!("{:?} {:?} {:b} {lanes:?}", c.radiance, k.points, k.mask)
+                            let points: Vec<_> = (0..LANES).map(|l| k.point(l)).collect();
+                            format!("{:?} {points:?} {:b} {lanes:?}", c.radiance, k.mask)
                         };
                         assert_eq!(text(&got), text(&want), "{name} {isa:?} tile {t}");
-                        points += want.packet.points.iter().flatten().count();
+                        points += want.packet.points().count();
                     }
                 }
             }

@@ -105,8 +105,10 @@ fn packets(scene: &PreparedScene, count: usize) -> Vec<(ShadingPacket<'_>, LaneV
                     &scene.world.materials[s.material as usize],
                 ))
             });
-            let mut packet = ShadingPacket::from_points(points);
+            let mut packet = ShadingPacket::from_points(&points);
             for lane in (0..LANES).filter(|l| packet.mask >> l & 1 == 0) {
+                packet.bsdf[lane] = Some(&scene.world.materials[0]);
+                packet.pixel[lane] = 7;
                 let g = &mut packet.geo;
                 let p = Vec3::new(123.0, -45.0, 6.0);
                 for (to, v) in [
@@ -179,7 +181,8 @@ fn light_probes_over_lanes_are_the_scalar_ones() {
             for isa in Isa::available() {
                 bound.isa = isa;
                 for (packet, values) in &packets {
-                    let points = &packet.points;
+                    let points: &[Option<ShadingPoint>; LANES] =
+                        &std::array::from_fn(|l| packet.point(l));
                     let mut want: [Option<LightProbe>; LANES] = [None; LANES];
                     let mut u = dims(values);
                     for lane in 0..LANES {
@@ -234,7 +237,8 @@ fn estimators_packets_are_their_samples() {
                 continue;
             };
             for (packet, values) in &packets {
-                let points = &packet.points;
+                let points: &[Option<ShadingPoint>; LANES] =
+                    &std::array::from_fn(|l| packet.point(l));
                 let mut want = [Probes::default(); LANES];
                 let mut u = dims(values);
                 for lane in 0..LANES {
@@ -290,7 +294,8 @@ fn env_weights_over_lanes_are_the_scalar_ones() {
                 continue;
             };
             for (packet, values) in &packets {
-                let points = &packet.points;
+                let points: &[Option<ShadingPoint>; LANES] =
+                    &std::array::from_fn(|l| packet.point(l));
                 let mut probes = [Probes::default(); LANES];
                 est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut probes);
                 let mut dirs = Soa3::default();
@@ -342,7 +347,8 @@ fn emission_weights_over_lanes_are_the_scalar_ones() {
                 continue;
             };
             for (packet, values) in &packets {
-                let points = &packet.points;
+                let points: &[Option<ShadingPoint>; LANES] =
+                    &std::array::from_fn(|l| packet.point(l));
                 let mut probes = [Probes::default(); LANES];
                 est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut probes);
                 let hits: [Option<SurfaceHit>; LANES] = std::array::from_fn(|lane| {

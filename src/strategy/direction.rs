@@ -159,13 +159,10 @@ impl Estimator for DirectionEstimator {
     /// `cosine`, the lanes of cosine-sampled materials for `bsdf`) are drawn and taken to world
     /// space over lanes; f, the pdf and the rest lane by lane.
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
-        let points = &packet.points;
         match self.strategy.kind {
             DirectionKind::UniformHemisphere => {
-                for (lane, (p, o)) in points.iter().zip(out.iter_mut()).enumerate() {
-                    if let Some(sp) = p {
-                        *o = self.sample(sp, &mut u.lane(lane));
-                    }
+                for (lane, sp) in packet.points() {
+                    out[lane] = self.sample(&sp, &mut u.lane(lane));
                 }
                 u.skip(2);
             }
@@ -176,25 +173,20 @@ impl Estimator for DirectionEstimator {
                 }
                 let q = cosine_query(packet, [u0, u1]);
                 let r = sample_cosine_lanes(self.isa, &q);
-                for (lane, (sp, o)) in points.iter().zip(out.iter_mut()).enumerate() {
-                    let Some(sp) = sp else { continue };
+                for (lane, sp) in packet.points() {
                     let (wi, pdf) = (r.wi.get(lane), cosine_hemisphere_pdf(r.z[lane]));
-                    *o = if sp.n.dot(wi) <= 0.0 || pdf <= 0.0 {
+                    out[lane] = if sp.n.dot(wi) <= 0.0 || pdf <= 0.0 {
                         Probes::default()
                     } else {
-                        emission_probe_with(sp, wi, sp.bsdf.eval_local(r.local.get(lane)), pdf)
+                        emission_probe_with(&sp, wi, sp.bsdf.eval_local(r.local.get(lane)), pdf)
                     };
                 }
             }
-            DirectionKind::Bsdf => bsdf_sample_packet(
-                self.isa,
-                packet,
-                u,
-                self.strategy.sampling,
-                |lane, sp, s| {
-                    out[lane] = emission_probe_with(sp, s.wi, s.f, s.pdf);
-                },
-            ),
+            DirectionKind::Bsdf => {
+                bsdf_sample_packet(self.isa, packet, u, self.strategy.sampling, |lane, s| {
+                    out[lane] = emission_probe_lane(packet, lane, s.wi, s.f, s.pdf);
+                })
+            }
         }
     }
 }
@@ -212,48 +204,69 @@ fn cosine_query(packet: &ShadingPacket, u: [&[f32; WIDTH]; 2]) -> CosineQuery {
 }
 
 /// `sp.bsdf.sample(u.get_3d(), sampling)` for each lane of a packet, bit for bit, handed to
-/// `emit(lane, point, sample)`: lanes whose material is cosine-sampled draw their directions
+/// `emit(lane, sample)`: lanes whose material is cosine-sampled draw their directions
 /// over lanes ([`sample_cosine_lanes`]: the lobe drawn by u[2] does not change the direction),
 /// the others one by one. f and the mixture pdf are evaluated lane by lane.
 #[inline(always)]
-pub fn bsdf_sample_packet<'p, 's>(
+pub fn bsdf_sample_packet(
     isa: Isa,
-    packet: &'p ShadingPacket<'s>,
+    packet: &ShadingPacket,
     u: &mut PacketDims,
     sampling: BsdfSampling,
-    mut emit: impl FnMut(usize, &'p ShadingPoint<'s>, BsdfSample),
+    mut emit: impl FnMut(usize, BsdfSample),
 ) {
     let [u0, u1, u2] = u.take::<3>();
-    let points = &packet.points;
     let mut mask = 0u32;
-    for (lane, sp) in points.iter().enumerate() {
-        let Some(sp) = sp else { continue };
-        if sp.bsdf.bsdf.is_cosine_sampled() {
+    let mut rest = packet.mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let Some(bsdf) = packet.local_bsdf(lane) else {
+            continue;
+        };
+        if bsdf.bsdf.is_cosine_sampled() {
             mask |= 1 << lane;
         } else {
-            emit(
-                lane,
-                sp,
-                sp.bsdf.sample([u0[lane], u1[lane], u2[lane]], sampling),
-            );
+            emit(lane, bsdf.sample([u0[lane], u1[lane], u2[lane]], sampling));
         }
     }
     if mask == 0 {
         return;
     }
     let r = sample_cosine_lanes(isa, &cosine_query(packet, [u0, u1]));
-    for (lane, sp) in points.iter().enumerate() {
-        let Some(sp) = sp.as_ref().filter(|_| mask >> lane & 1 != 0) else {
+    let mut rest = mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let Some(bsdf) = packet.local_bsdf(lane) else {
             continue;
         };
         let local = r.local.get(lane);
         let sample = BsdfSample {
             wi: r.wi.get(lane),
-            f: sp.bsdf.eval_local(local),
-            pdf: sp.bsdf.pdf_local(local, sampling),
+            f: bsdf.eval_local(local),
+            pdf: bsdf.pdf_local(local, sampling),
         };
-        emit(lane, sp, sample);
+        emit(lane, sample);
     }
+}
+
+/// [`emission_probe_with`] for lane `lane` of `packet`, from its lanes (no point is built).
+#[inline(always)]
+pub fn emission_probe_lane(
+    packet: &ShadingPacket,
+    lane: usize,
+    wi: glam::Vec3,
+    f: glam::Vec3,
+    pdf: f32,
+) -> Probes {
+    emission_probe_from(
+        packet.geo.origin.get(lane),
+        packet.geo.n.get(lane),
+        wi,
+        f,
+        pdf,
+    )
 }
 
 /// The emission probe for a direction sampled with solid-angle pdf `pdf`; nothing for
@@ -269,7 +282,19 @@ pub fn emission_probe(sp: &ShadingPoint, wi: glam::Vec3, pdf: f32) -> Probes {
 
 /// As [`emission_probe`] with f(wi) already known (a BSDF sample carries it).
 pub fn emission_probe_with(sp: &ShadingPoint, wi: glam::Vec3, f: glam::Vec3, pdf: f32) -> Probes {
-    let cos = sp.n.dot(wi);
+    emission_probe_from(sp.origin, sp.n, wi, f, pdf)
+}
+
+/// [`emission_probe_with`] for the point whose rays leave from `origin`, normal `n`.
+#[inline(always)]
+fn emission_probe_from(
+    origin: glam::Vec3,
+    n: glam::Vec3,
+    wi: glam::Vec3,
+    f: glam::Vec3,
+    pdf: f32,
+) -> Probes {
+    let cos = n.dot(wi);
     if cos <= 0.0 || pdf <= 0.0 {
         return Probes::default();
     }
@@ -277,7 +302,7 @@ pub fn emission_probe_with(sp: &ShadingPoint, wi: glam::Vec3, f: glam::Vec3, pdf
     Probes {
         shadow: None,
         emission: Some(EmissionProbe {
-            ray: Ray::new(sp.origin, wi, f32::INFINITY),
+            ray: Ray::new(origin, wi, f32::INFINITY),
             weight,
             pdf,
         }),

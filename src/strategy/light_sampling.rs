@@ -211,8 +211,8 @@ impl<'s> BoundLights<'s> {
         u: &mut PacketDims,
         out: &mut [Option<LightProbe>; LANES],
     ) {
-        for (o, p) in out.iter_mut().zip(&packet.points) {
-            if p.is_some() {
+        for (lane, o) in out.iter_mut().enumerate() {
+            if packet.mask >> lane & 1 != 0 {
                 *o = None;
             }
         }
@@ -264,7 +264,6 @@ impl<'s> BoundLights<'s> {
             }
             chosen = c;
         }
-        let points = &packet.points;
         // Lights with a kernel over lanes of different lights (mesh triangles) hand over their
         // records; each such kernel samples all its lanes at once.
         let mut ls = LaneSamples::default();
@@ -316,18 +315,21 @@ impl<'s> BoundLights<'s> {
             }
         }
         let r = simd::run(self.isa, Kernel(&q, &ls, &x));
-        for (lane, sp) in points.iter().enumerate() {
-            let Some(sp) = sp else { continue };
-            if r.valid >> lane & 1 == 0 {
-                continue;
-            }
+        // Only f is evaluated lane by lane, from the lanes (no point is built).
+        let mut valid = r.valid & packet.mask;
+        while valid != 0 {
+            let lane = valid.trailing_zeros() as usize;
+            valid &= valid - 1;
+            let bsdf = packet
+                .local_bsdf(lane)
+                .expect("a valid shadow lane has a point");
             let local = r.local.get(lane);
             let mut sample = ls
                 .get(lane)
                 .expect("a valid shadow lane has a light sample");
             sample.pdf = r.pdf[lane];
-            let value = sp.bsdf.eval_local(local) * sample.radiance * r.factor[lane];
-            let ray = Ray::new(sp.origin, r.dir.get(lane), r.tmax[lane]);
+            let value = bsdf.eval_local(local) * sample.radiance * r.factor[lane];
+            let ray = Ray::new(packet.geo.origin.get(lane), r.dir.get(lane), r.tmax[lane]);
             emit(
                 lane,
                 (ShadowProbe { ray, value }, sample, local, light[lane]),
@@ -363,12 +365,7 @@ impl<'s> BoundLights<'s> {
     /// [`Self::env_pdf`] of the directions `dirs` from the points of lanes `mask` (0 in the
     /// others): the environment's pdf over lanes, each lane's selection pmf after it, in the
     /// scalar order (pmf · pdf).
-    pub fn env_pdf_packet(
-        &self,
-        points: &[Option<ShadingPoint>; LANES],
-        dirs: &Soa3,
-        mask: u32,
-    ) -> [f32; LANES] {
+    pub fn env_pdf_packet(&self, packet: &ShadingPacket, dirs: &Soa3, mask: u32) -> [f32; LANES] {
         let mut out = [0.0f32; LANES];
         let (Some(i), Some(env)) = (self.lights.environment_index(), self.lights.environment())
         else {
@@ -378,10 +375,8 @@ impl<'s> BoundLights<'s> {
             .map(self.methods.env.repr)
             .pdf_lanes(self.isa, dirs, mask);
         for (lane, o) in out.iter_mut().enumerate() {
-            if mask >> lane & 1 != 0
-                && let Some(sp) = &points[lane]
-            {
-                *o = self.selector.pmf(&sp.light_ctx(), i) * pdf[lane];
+            if (mask & packet.mask) >> lane & 1 != 0 {
+                *o = self.selector.pmf(&packet.light_ctx(lane), i) * pdf[lane];
             }
         }
         out
@@ -483,8 +478,8 @@ impl Estimator for LightEstimator<'_> {
     }
 
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
-        for (o, p) in out.iter_mut().zip(&packet.points) {
-            if p.is_some() {
+        for (lane, o) in out.iter_mut().enumerate() {
+            if packet.mask >> lane & 1 != 0 {
                 *o = Probes::default();
             }
         }

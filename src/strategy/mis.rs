@@ -5,13 +5,13 @@
 //! includes the light-selection pmf (redner #56). The BSDF sample, and the BSDF pdf of light
 //! samples, follow the strategy's [`BsdfSampling`] part (lobe selection, GGX sampler).
 
-use super::direction::{BSDF_DIMS, bsdf_sample_packet, emission_probe_with};
+use super::direction::{BSDF_DIMS, bsdf_sample_packet, emission_probe_lane, emission_probe_with};
 use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
 use super::{
     EmissionProbe, Estimator, Integrand, Probes, ShadingPacket, ShadingPoint, ShadowProbe,
     Strategy, env_method_name,
 };
-use crate::bsdf::BsdfSampling;
+use crate::bsdf::{BsdfSampling, LocalBsdf};
 use crate::env::EnvMethod;
 use crate::lights::selector::{SelectorType, default_selector};
 use crate::lights::{LightMethods, LightShape, SurfaceLanes};
@@ -234,11 +234,11 @@ struct MisEstimator<'s> {
 
 impl MisEstimator<'_> {
     /// The light probe with its MIS weight.
-    fn weighted(&self, sp: &ShadingPoint, light: Option<LightProbe>) -> Option<ShadowProbe> {
+    fn weighted(&self, bsdf: &LocalBsdf, light: Option<LightProbe>) -> Option<ShadowProbe> {
         light.map(|(mut probe, ls, local, light)| {
             // A delta light is reachable by light sampling only: its weight is 1.
             if !self.lights.lights.get(light).is_delta() {
-                let p_bsdf = sp.bsdf.pdf_local(local, self.strategy.sampling);
+                let p_bsdf = bsdf.pdf_local(local, self.strategy.sampling);
                 probe.value *= self.strategy.heuristic.weight(ls.pdf, p_bsdf);
             }
             probe
@@ -247,7 +247,7 @@ impl MisEstimator<'_> {
 
     /// The sample after its light probe: the probe's MIS weight, then the BSDF sample.
     fn finish(&self, sp: &ShadingPoint, light: Option<LightProbe>, u: &mut Dims) -> Probes {
-        let shadow = self.weighted(sp, light);
+        let shadow = self.weighted(&sp.bsdf, light);
         let bs = sp.bsdf.sample(u.get_3d(), self.strategy.sampling);
         let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
         Probes { shadow, emission }
@@ -265,16 +265,15 @@ impl Estimator for MisEstimator<'_> {
     }
 
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
-        let points = &packet.points;
-        for (o, sp) in out.iter_mut().zip(points) {
-            if sp.is_some() {
+        for (lane, o) in out.iter_mut().enumerate() {
+            if packet.mask >> lane & 1 != 0 {
                 o.shadow = None;
             }
         }
         // Each probe weighted as it is made (no packet of full light probes stored and copied).
         self.lights.probe_packet_each(packet, u, |lane, probe| {
-            if let Some(sp) = &points[lane] {
-                out[lane].shadow = self.weighted(sp, Some(probe));
+            if let Some(bsdf) = packet.local_bsdf(lane) {
+                out[lane].shadow = self.weighted(&bsdf, Some(probe));
             }
         });
         bsdf_sample_packet(
@@ -282,8 +281,8 @@ impl Estimator for MisEstimator<'_> {
             packet,
             u,
             self.strategy.sampling,
-            |lane, sp, bs| {
-                out[lane].emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission
+            |lane, bs| {
+                out[lane].emission = emission_probe_lane(packet, lane, bs.wi, bs.f, bs.pdf).emission
             },
         );
     }
@@ -300,16 +299,15 @@ impl Estimator for MisEstimator<'_> {
         probes: &[Probes; LANES],
         hits: &[Option<SurfaceHit>; LANES],
     ) -> [f32; LANES] {
-        let points = &packet.points;
         let mut at = SurfaceLanes::default();
         let mut light = [0u32; LANES];
         let mut mask = 0u32;
         for lane in 0..LANES {
-            if let (Some(sp), Some(_), Some(hit)) =
-                (&points[lane], &probes[lane].emission, &hits[lane])
+            if packet.mask >> lane & 1 != 0
+                && let (Some(_), Some(hit)) = (&probes[lane].emission, &hits[lane])
                 && let Some(e) = hit.emitter
             {
-                at.set(lane, &sp.light_ctx(), hit.p, e.local);
+                at.set(lane, &packet.light_ctx(lane), hit.p, e.local);
                 light[lane] = e.light;
                 mask |= 1 << lane;
             }
@@ -338,7 +336,7 @@ impl Estimator for MisEstimator<'_> {
         dirs: &Soa3,
         mask: u32,
     ) -> [f32; LANES] {
-        let p_light = self.lights.env_pdf_packet(&packet.points, dirs, mask);
+        let p_light = self.lights.env_pdf_packet(packet, dirs, mask);
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0

@@ -137,16 +137,19 @@ impl ShadingLanes {
     }
 }
 
-/// A packet of up to 16 shading points, each both as a [`ShadingPoint`] (for parts that shade
-/// lane by lane) and in lanes (for parts written over lanes, which then move no point in or
-/// out of its struct): in the lanes of `mask`, `p` and `geo` hold what `points` holds there;
-/// other lanes hold finite values that nothing reads.
+/// A packet of up to 16 shading points, in lanes: parts written over lanes read the rows
+/// (`p`, `geo`) and move no point in or out of a struct; a part that shades lane by lane asks
+/// for a lane's [`ShadingPoint`] ([`Self::point`]), built from the lanes when it is asked for.
+/// Only the lanes of `mask` hold a point; the others hold finite values that nothing reads.
 #[derive(Clone, Debug)]
 pub struct ShadingPacket<'a> {
-    pub points: [Option<ShadingPoint<'a>>; LANES],
     /// The points' positions (`ShadingPoint::p`).
     pub p: Soa3,
     pub geo: ShadingLanes,
+    /// Each point's material (Some in every lane of `mask`).
+    pub bsdf: [Option<&'a Bsdf>; LANES],
+    /// Each point's pixel (`ShadingPoint::pixel`).
+    pub pixel: [u32; LANES],
     /// The lanes that hold a point.
     pub mask: u32,
 }
@@ -154,26 +157,26 @@ pub struct ShadingPacket<'a> {
 impl Default for ShadingPacket<'_> {
     fn default() -> Self {
         ShadingPacket {
-            points: [None; LANES],
             p: Soa3::default(),
             geo: ShadingLanes::default(),
+            bsdf: [None; LANES],
+            pixel: [u32::MAX; LANES],
             mask: 0,
         }
     }
 }
 
 impl<'a> ShadingPacket<'a> {
-    /// The packet of `points`, their lanes gathered from them (a test's or a closed-form
-    /// check's packet; the renderer computes the lanes first and the points from them).
-    pub fn from_points(points: [Option<ShadingPoint<'a>>; LANES]) -> Self {
-        let mut packet = ShadingPacket {
-            points,
-            ..Default::default()
-        };
+    /// The packet of `points` (a test's or a closed-form check's packet; the renderer
+    /// computes the lanes directly).
+    pub fn from_points(points: &[Option<ShadingPoint<'a>>; LANES]) -> Self {
+        let mut packet = ShadingPacket::default();
         for (lane, sp) in points.iter().enumerate() {
             let Some(sp) = sp else { continue };
             packet.mask |= 1 << lane;
             packet.p.set(lane, sp.p);
+            packet.bsdf[lane] = Some(sp.bsdf.bsdf);
+            packet.pixel[lane] = sp.pixel;
             let g = &mut packet.geo;
             g.n.set(lane, sp.n);
             g.s.set(lane, sp.bsdf.frame.s);
@@ -183,6 +186,52 @@ impl<'a> ShadingPacket<'a> {
             g.origin.set(lane, sp.origin);
         }
         packet
+    }
+
+    /// Lane `lane`'s point; None outside `mask`.
+    #[inline(always)]
+    pub fn point(&self, lane: usize) -> Option<ShadingPoint<'a>> {
+        if self.mask >> lane & 1 == 0 {
+            return None;
+        }
+        let bsdf = self.bsdf[lane].expect("a material in every lane with a point");
+        let mut sp = ShadingPoint::from_lanes(&self.geo, lane, self.p.get(lane), bsdf);
+        sp.pixel = self.pixel[lane];
+        Some(sp)
+    }
+
+    /// The points of the lanes of `mask`, with their lanes, in lane order.
+    #[inline(always)]
+    pub fn points(&self) -> impl Iterator<Item = (usize, ShadingPoint<'a>)> + '_ {
+        (0..LANES).filter_map(|lane| Some((lane, self.point(lane)?)))
+    }
+
+    /// What a light sampler or selector is told about lane `lane`'s point.
+    #[inline(always)]
+    pub fn light_ctx(&self, lane: usize) -> LightCtx {
+        LightCtx {
+            p: self.p.get(lane),
+            n: self.geo.n.get(lane),
+        }
+    }
+
+    /// Lane `lane`'s material in its shading frame (what evaluating f needs, without the
+    /// rest of the point).
+    #[inline(always)]
+    pub fn local_bsdf(&self, lane: usize) -> Option<LocalBsdf<'a>> {
+        if self.mask >> lane & 1 == 0 {
+            return None;
+        }
+        let g = &self.geo;
+        Some(LocalBsdf {
+            frame: Frame {
+                s: g.s.get(lane),
+                t: g.t.get(lane),
+                n: g.n.get(lane),
+            },
+            wo: g.wo_local.get(lane),
+            bsdf: self.bsdf[lane].expect("a material in every lane with a point"),
+        })
     }
 }
 
@@ -300,12 +349,10 @@ pub trait Estimator: Send + Sync {
     /// `u` ([`PacketDims::take`]) and the points' lanes ([`ShadingPacket::geo`]).
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
         let mut used = 0;
-        for (lane, (p, o)) in packet.points.iter().zip(out.iter_mut()).enumerate() {
-            if let Some(sp) = p {
-                let mut d = u.lane(lane);
-                *o = self.sample(sp, &mut d);
-                used = used.max(d.used());
-            }
+        for (lane, sp) in packet.points() {
+            let mut d = u.lane(lane);
+            out[lane] = self.sample(&sp, &mut d);
+            used = used.max(d.used());
         }
         u.skip(used);
     }
@@ -331,10 +378,10 @@ pub trait Estimator: Send + Sync {
     ) -> [f32; LANES] {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
-            if let (Some(sp), Some(probe), Some(hit)) =
-                (&packet.points[lane], &probes[lane].emission, &hits[lane])
+            if let (Some(probe), Some(hit)) = (&probes[lane].emission, &hits[lane])
+                && let Some(sp) = packet.point(lane)
             {
-                *o = self.emission_weight(sp, probe, hit);
+                *o = self.emission_weight(&sp, probe, hit);
             }
         }
         out
@@ -358,9 +405,9 @@ pub trait Estimator: Send + Sync {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0
-                && let (Some(sp), Some(probe)) = (&packet.points[lane], &probes[lane].emission)
+                && let (Some(sp), Some(probe)) = (packet.point(lane), &probes[lane].emission)
             {
-                *o = self.env_weight(sp, probe);
+                *o = self.env_weight(&sp, probe);
             }
         }
         out
