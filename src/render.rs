@@ -17,7 +17,7 @@ use crate::sampling::{GENERATORS, LaneValues, PacketDims, SampleGenerator, Sampl
 use crate::scene::Camera;
 use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector};
 use crate::strategy::{
-    EmissionProbe, Estimator, PassPoints, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
+    EmissionProbe, Estimator, PassPoints, ProbePacket, ShadingLanes, ShadingPacket, ShadingPoint,
     Strategy,
 };
 use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
@@ -70,9 +70,9 @@ struct TileScratch {
     lanes: HitLanes,
     /// The hit points' error bounds (the points and their geometry go to the tile).
     p_error: Soa3,
-    /// The shading phase's shadow and emission packets and the emission rays' hits.
-    shadow: RayPacket,
-    emit: RayPacket,
+    /// The shading phase's probes (their shadow and emission packets) and the emission rays'
+    /// hits.
+    probes: ProbePacket,
     emit_hits: HitPacket,
 }
 
@@ -362,42 +362,28 @@ impl<'a> Renderer<'a> {
         let scene = self.scene;
         let mut radiance = tile.radiance;
         let mut dims = PacketDims::new(&tile.values, 2, self.dims);
-        let mut probes = [Probes::default(); LANES];
-        self.estimator
-            .sample_packet(&tile.packet, &mut dims, &mut probes);
-
         let TileScratch {
-            shadow,
-            emit,
+            probes,
             emit_hits: ehits,
             ..
         } = scratch;
-        let mut shadow_mask: LaneMask = 0;
-        let mut emit_mask: LaneMask = 0;
-        for (lane, p) in probes.iter().enumerate() {
-            if tile.packet.mask >> lane & 1 == 0 {
-                continue;
-            }
-            if let Some(s) = p.shadow {
-                shadow.set(lane, &s.ray);
-                shadow_mask |= 1 << lane;
-            }
-            if let Some(e) = p.emission {
-                emit.set(lane, &e.ray);
-                emit_mask |= 1 << lane;
-            }
-        }
+        probes.clear();
+        self.estimator
+            .sample_packet(&tile.packet, &mut dims, probes);
+        // The estimator leaves the lanes without a point without probes.
+        let shadow_mask = (probes.shadow_mask & tile.packet.mask) as LaneMask;
+        let emit_mask = (probes.emission_mask & tile.packet.mask) as LaneMask;
         if shadow_mask != 0 {
-            let blocked = scene.tracer.occluded_packet(shadow, shadow_mask);
-            for (lane, p) in probes.iter().enumerate() {
-                if shadow_mask & !blocked & (1 << lane) != 0
-                    && let Some(s) = p.shadow
-                {
-                    radiance[lane] += s.value;
-                }
+            let blocked = scene.tracer.occluded_packet(&probes.shadow, shadow_mask);
+            let mut clear = shadow_mask & !blocked;
+            while clear != 0 {
+                let lane = clear.trailing_zeros() as usize;
+                clear &= clear - 1;
+                radiance[lane] += probes.shadow_value.get(lane);
             }
         }
         if emit_mask != 0 {
+            let emit = &probes.emission;
             scene.tracer.intersect_packet(emit, emit_mask, ehits);
             // What the escaped emission rays see of the environment, looked up over lanes.
             let mut escaped = 0u32;
@@ -418,13 +404,15 @@ impl<'a> Renderer<'a> {
                     .add_env_radiance(self.isa, &dirs, escaped, &mut env);
                 env_weight =
                     self.estimator()
-                        .env_weight_packet(&tile.packet, &probes, &dirs, escaped);
+                        .env_weight_packet(&tile.packet, probes, &dirs, escaped);
             }
             // The emitting surfaces the rest found, weighted over lanes.
             let mut surfaces: [Option<SurfaceHit>; LANES] = [None; LANES];
             let mut le = [Vec3::ZERO; LANES];
             for lane in 0..LANES {
-                let Some(probe) = probes[lane].emission.filter(|_| emit_mask >> lane & 1 != 0)
+                let Some(probe) = probes
+                    .emission_probe(lane)
+                    .filter(|_| emit_mask >> lane & 1 != 0)
                 else {
                     continue;
                 };
@@ -441,10 +429,11 @@ impl<'a> Renderer<'a> {
             if surfaces.iter().any(Option::is_some) {
                 let w = self
                     .estimator()
-                    .emission_weight_packet(&tile.packet, &probes, &surfaces);
+                    .emission_weight_packet(&tile.packet, probes, &surfaces);
                 for lane in 0..LANES {
-                    if let (Some(probe), Some(_)) = (probes[lane].emission, surfaces[lane]) {
-                        radiance[lane] += probe.weight * le[lane] * w[lane];
+                    if surfaces[lane].is_some() {
+                        let weight = probes.emission_weight.get(lane);
+                        radiance[lane] += weight * le[lane] * w[lane];
                     }
                 }
             }

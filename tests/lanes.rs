@@ -4,6 +4,7 @@
 //! ([`Estimator::sample_packet`]) must equal the scalar ones lane by lane, bit for bit, and
 //! consume the same sample dimensions.
 
+use dibench::geometry::Ray;
 use dibench::lights::selector::default_selector;
 use dibench::lights::{LightMethods, MethodOverride};
 use dibench::prepare::{PreparedScene, SurfaceHit};
@@ -14,7 +15,9 @@ use dibench::sampling::{Dims, LaneValues, PacketDims};
 use dibench::scene::Scene;
 use dibench::simd::{Isa, Soa3};
 use dibench::strategy::light_sampling::{BoundLights, LightProbe};
-use dibench::strategy::{Probes, ShadingPacket, ShadingPoint, by_name};
+use dibench::strategy::{
+    EmissionProbe, ProbePacket, Probes, ShadingPacket, ShadingPoint, ShadowProbe, by_name,
+};
 use dibench::tracer::LANES;
 use glam::Vec3;
 
@@ -149,6 +152,31 @@ fn dimensions_read(packet: &ShadingPacket, u: &[Dims; LANES], pu: &PacketDims) -
     v
 }
 
+/// The probes a renderer's reused packet holds before a tile: an earlier tile's rows, every
+/// lane cleared. Nothing may read the rows of a lane that gets no probe.
+fn stale_probes() -> ProbePacket {
+    let mut p = ProbePacket::default();
+    let ray = Ray::new(Vec3::new(9.0, -3.0, 2.0), Vec3::Y, 5.0);
+    for lane in 0..LANES {
+        p.set(
+            lane,
+            Probes {
+                shadow: Some(ShadowProbe {
+                    ray,
+                    value: Vec3::splat(4.0),
+                }),
+                emission: Some(EmissionProbe {
+                    ray,
+                    weight: Vec3::splat(3.0),
+                    pdf: 0.5,
+                }),
+            },
+        );
+    }
+    p.clear();
+    p
+}
+
 /// Debug text prints every float by its shortest round trip, so equal text is equal bits.
 fn same<T: std::fmt::Debug>(a: &T, b: &T) -> bool {
     format!("{a:?}") == format!("{b:?}")
@@ -246,9 +274,10 @@ fn estimators_packets_are_their_samples() {
                         want[lane] = est.sample(sp, &mut u[lane]);
                     }
                 }
-                let mut got = [Probes::default(); LANES];
+                let mut got = stale_probes();
                 let mut pu = PacketDims::new(values, 0, DIMS);
                 est.sample_packet(packet, &mut pu, &mut got);
+                let got: [Probes; LANES] = std::array::from_fn(|lane| got.get(lane));
                 let read = dimensions_read(packet, &u, &pu);
                 assert!(
                     read.iter().all(|&n| n == read[0]),
@@ -296,8 +325,9 @@ fn env_weights_over_lanes_are_the_scalar_ones() {
             for (packet, values) in &packets {
                 let points: &[Option<ShadingPoint>; LANES] =
                     &std::array::from_fn(|l| packet.point(l));
-                let mut probes = [Probes::default(); LANES];
-                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut probes);
+                let mut packed = stale_probes();
+                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut packed);
+                let probes: [Probes; LANES] = std::array::from_fn(|lane| packed.get(lane));
                 let mut dirs = Soa3::default();
                 let mut mask = 0u32;
                 for lane in 0..LANES {
@@ -306,7 +336,7 @@ fn env_weights_over_lanes_are_the_scalar_ones() {
                         mask |= 1 << lane;
                     }
                 }
-                let got = est.env_weight_packet(packet, &probes, &dirs, mask);
+                let got = est.env_weight_packet(packet, &packed, &dirs, mask);
                 for lane in 0..LANES {
                     if mask >> lane & 1 == 0 {
                         continue;
@@ -349,8 +379,9 @@ fn emission_weights_over_lanes_are_the_scalar_ones() {
             for (packet, values) in &packets {
                 let points: &[Option<ShadingPoint>; LANES] =
                     &std::array::from_fn(|l| packet.point(l));
-                let mut probes = [Probes::default(); LANES];
-                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut probes);
+                let mut packed = stale_probes();
+                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut packed);
+                let probes: [Probes; LANES] = std::array::from_fn(|lane| packed.get(lane));
                 let hits: [Option<SurfaceHit>; LANES] = std::array::from_fn(|lane| {
                     let e = probes[lane]
                         .emission
@@ -360,7 +391,7 @@ fn emission_weights_over_lanes_are_the_scalar_ones() {
                     scene.world.prim_emitter[hit.prim as usize]?;
                     Some(scene.world.surface(&e.ray, &hit))
                 });
-                let got = est.emission_weight_packet(packet, &probes, &hits);
+                let got = est.emission_weight_packet(packet, &packed, &hits);
                 for lane in 0..LANES {
                     let Some(hit) = &hits[lane] else { continue };
                     let (sp, e) = (points[lane].as_ref().unwrap(), &probes[lane].emission);

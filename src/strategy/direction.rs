@@ -3,7 +3,7 @@
 //! mixture, by the strategy's [`BsdfSampling`] part: lobe selection and GGX sampler).
 //! Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
 
-use super::{EmissionProbe, Estimator, Probes, ShadingPacket, ShadingPoint, Strategy};
+use super::{EmissionProbe, Estimator, ProbePacket, Probes, ShadingPacket, ShadingPoint, Strategy};
 use crate::bsdf::{BsdfSample, BsdfSampling, CosineQuery, sample_cosine_lanes};
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
@@ -13,7 +13,6 @@ use crate::sampling::warp::{
 };
 use crate::sampling::{Dimension, Dims, Layout, PacketDims};
 use crate::simd::{Isa, WIDTH};
-use crate::tracer::LANES;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DirectionKind {
@@ -158,11 +157,11 @@ impl Estimator for DirectionEstimator {
     /// [`Self::sample`] for a packet, bit for bit: cosine-hemisphere directions (every lane of
     /// `cosine`, the lanes of cosine-sampled materials for `bsdf`) are drawn and taken to world
     /// space over lanes; f, the pdf and the rest lane by lane.
-    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
         match self.strategy.kind {
             DirectionKind::UniformHemisphere => {
                 for (lane, sp) in packet.points() {
-                    out[lane] = self.sample(&sp, &mut u.lane(lane));
+                    out.set(lane, self.sample(&sp, &mut u.lane(lane)));
                 }
                 u.skip(2);
             }
@@ -175,16 +174,15 @@ impl Estimator for DirectionEstimator {
                 let r = sample_cosine_lanes(self.isa, &q);
                 for (lane, sp) in packet.points() {
                     let (wi, pdf) = (r.wi.get(lane), cosine_hemisphere_pdf(r.z[lane]));
-                    out[lane] = if sp.n.dot(wi) <= 0.0 || pdf <= 0.0 {
-                        Probes::default()
-                    } else {
-                        emission_probe_with(&sp, wi, sp.bsdf.eval_local(r.local.get(lane)), pdf)
-                    };
+                    if sp.n.dot(wi) > 0.0 && pdf > 0.0 {
+                        let f = sp.bsdf.eval_local(r.local.get(lane));
+                        out.set(lane, emission_probe_with(&sp, wi, f, pdf));
+                    }
                 }
             }
             DirectionKind::Bsdf => {
                 bsdf_sample_packet(self.isa, packet, u, self.strategy.sampling, |lane, s| {
-                    out[lane] = emission_probe_lane(packet, lane, s.wi, s.f, s.pdf);
+                    out.set(lane, emission_probe_lane(packet, lane, s.wi, s.f, s.pdf));
                 })
             }
         }

@@ -4,9 +4,10 @@
 //! pins the environment's representation and sampler.
 
 use super::{
-    Estimator, Integrand, Probes, ShadingLanes, ShadingPacket, ShadingPoint, ShadowProbe, Strategy,
-    env_method_name,
+    Estimator, Integrand, ProbePacket, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
+    ShadowProbe, Strategy, env_method_name,
 };
+use crate::bsdf::LocalBsdf;
 use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
@@ -228,6 +229,71 @@ impl<'s> BoundLights<'s> {
         u: &mut PacketDims,
         mut emit: impl FnMut(usize, LightProbe),
     ) {
+        let (r, ls, light) = self.shadow_rays(packet, u);
+        // Only f is evaluated lane by lane, from the lanes (no point is built).
+        let mut valid = r.valid & packet.mask;
+        while valid != 0 {
+            let lane = valid.trailing_zeros() as usize;
+            valid &= valid - 1;
+            let bsdf = packet
+                .local_bsdf(lane)
+                .expect("a valid shadow lane has a point");
+            let local = r.local.get(lane);
+            let mut sample = ls
+                .get(lane)
+                .expect("a valid shadow lane has a light sample");
+            sample.pdf = r.pdf[lane];
+            let value = bsdf.eval_local(local) * sample.radiance * r.factor[lane];
+            let ray = Ray::new(packet.geo.origin.get(lane), r.dir.get(lane), r.tmax[lane]);
+            emit(
+                lane,
+                (ShadowProbe { ray, value }, sample, local, light[lane]),
+            );
+        }
+    }
+
+    /// [`Self::probe_packet`]'s shadow probes written into `out`'s shadow rows (the rays as
+    /// the kernel computed them, no lane moved on its own), each value times
+    /// `weight(lane, bsdf, pdf, local, light)` (1 for plain light sampling, the MIS weight for
+    /// MIS: `value · w`, as the scalar path's `value *= w`): the lane's material, the light
+    /// sample's pdf with the selection's, its direction in the shading frame and the light.
+    #[inline(always)]
+    pub fn probe_packet_rows(
+        &self,
+        packet: &ShadingPacket,
+        u: &mut PacketDims,
+        out: &mut ProbePacket,
+        mut weight: impl FnMut(usize, &LocalBsdf, f32, Vec3, usize) -> f32,
+    ) {
+        let (r, ls, light) = self.shadow_rays(packet, u);
+        let valid = r.valid & packet.mask;
+        let (o, origin) = (&mut out.shadow, &packet.geo.origin);
+        (o.ox, o.oy, o.oz) = (origin.x, origin.y, origin.z);
+        (o.dx, o.dy, o.dz) = (r.dir.x, r.dir.y, r.dir.z);
+        o.tmax = r.tmax;
+        out.shadow_mask = valid;
+        let mut rest = valid;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let bsdf = packet
+                .local_bsdf(lane)
+                .expect("a valid shadow lane has a point");
+            let local = r.local.get(lane);
+            let value = bsdf.eval_local(local) * ls.radiance.get(lane) * r.factor[lane];
+            let w = weight(lane, &bsdf, r.pdf[lane], local, light[lane]);
+            out.shadow_value.set(lane, value * w);
+        }
+    }
+
+    /// The shadow rays of a packet's light samples: the lights chosen lane by lane, each
+    /// chosen light sampling its lanes at once, then the segments, cosines and pdfs over lanes.
+    #[inline(always)]
+    fn shadow_rays(
+        &self,
+        packet: &ShadingPacket,
+        u: &mut PacketDims,
+    ) -> (ShadowRays, LaneSamples, [usize; LANES]) {
         let [u_select, u0, u1, u2] = u.take::<4>();
         // The points and their sample numbers, as rows (no lane is moved on its own).
         let q = LaneQuery {
@@ -314,27 +380,7 @@ impl<'s> BoundLights<'s> {
                 shadow_lanes::<L::V>(self.0, self.1, self.2)
             }
         }
-        let r = simd::run(self.isa, Kernel(&q, &ls, &x));
-        // Only f is evaluated lane by lane, from the lanes (no point is built).
-        let mut valid = r.valid & packet.mask;
-        while valid != 0 {
-            let lane = valid.trailing_zeros() as usize;
-            valid &= valid - 1;
-            let bsdf = packet
-                .local_bsdf(lane)
-                .expect("a valid shadow lane has a point");
-            let local = r.local.get(lane);
-            let mut sample = ls
-                .get(lane)
-                .expect("a valid shadow lane has a light sample");
-            sample.pdf = r.pdf[lane];
-            let value = bsdf.eval_local(local) * sample.radiance * r.factor[lane];
-            let ray = Ray::new(packet.geo.origin.get(lane), r.dir.get(lane), r.tmax[lane]);
-            emit(
-                lane,
-                (ShadowProbe { ray, value }, sample, local, light[lane]),
-            );
-        }
+        (simd::run(self.isa, Kernel(&q, &ls, &x)), ls, light)
     }
 
     /// The pdf with which [`Self::probe`] samples the direction to point `q` of part `local`
@@ -477,13 +523,8 @@ impl Estimator for LightEstimator<'_> {
         }
     }
 
-    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
-        for (lane, o) in out.iter_mut().enumerate() {
-            if packet.mask >> lane & 1 != 0 {
-                *o = Probes::default();
-            }
-        }
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
         self.0
-            .probe_packet_each(packet, u, |lane, (p, ..)| out[lane] = Probes::shadow(p));
+            .probe_packet_rows(packet, u, out, |_, _, _, _, _| 1.0);
     }
 }

@@ -8,8 +8,8 @@
 use super::direction::{BSDF_DIMS, bsdf_sample_packet, emission_probe_lane, emission_probe_with};
 use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
 use super::{
-    EmissionProbe, Estimator, Integrand, Probes, ShadingPacket, ShadingPoint, ShadowProbe,
-    Strategy, env_method_name,
+    EmissionProbe, Estimator, Integrand, ProbePacket, Probes, ShadingPacket, ShadingPoint,
+    ShadowProbe, Strategy, env_method_name,
 };
 use crate::bsdf::{BsdfSampling, LocalBsdf};
 use crate::env::EnvMethod;
@@ -238,11 +238,18 @@ impl MisEstimator<'_> {
         light.map(|(mut probe, ls, local, light)| {
             // A delta light is reachable by light sampling only: its weight is 1.
             if !self.lights.lights.get(light).is_delta() {
-                let p_bsdf = bsdf.pdf_local(local, self.strategy.sampling);
-                probe.value *= self.strategy.heuristic.weight(ls.pdf, p_bsdf);
+                probe.value *= self.light_weight(bsdf, ls.pdf, local);
             }
             probe
         })
+    }
+
+    /// The MIS weight of a light sample of pdf `pdf` (selection included) in direction
+    /// `local` (shading frame) from a point of material `bsdf`.
+    #[inline(always)]
+    fn light_weight(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3) -> f32 {
+        let p_bsdf = bsdf.pdf_local(local, self.strategy.sampling);
+        self.strategy.heuristic.weight(pdf, p_bsdf)
     }
 
     /// The sample after its light probe: the probe's MIS weight, then the BSDF sample.
@@ -264,25 +271,25 @@ impl Estimator for MisEstimator<'_> {
         self.finish(sp, light, u)
     }
 
-    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
-        for (lane, o) in out.iter_mut().enumerate() {
-            if packet.mask >> lane & 1 != 0 {
-                o.shadow = None;
-            }
-        }
-        // Each probe weighted as it is made (no packet of full light probes stored and copied).
-        self.lights.probe_packet_each(packet, u, |lane, probe| {
-            if let Some(bsdf) = packet.local_bsdf(lane) {
-                out[lane].shadow = self.weighted(&bsdf, Some(probe));
-            }
-        });
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
+        // Each light probe weighted as its value is made; a delta light's weight is 1
+        // (`value · 1` is `value`, as in the scalar path, which leaves it alone).
+        self.lights
+            .probe_packet_rows(packet, u, out, |_, bsdf, pdf, local, light| {
+                if self.lights.lights.get(light).is_delta() {
+                    1.0
+                } else {
+                    self.light_weight(bsdf, pdf, local)
+                }
+            });
         bsdf_sample_packet(
             self.lights.isa,
             packet,
             u,
             self.strategy.sampling,
             |lane, bs| {
-                out[lane].emission = emission_probe_lane(packet, lane, bs.wi, bs.f, bs.pdf).emission
+                let e = emission_probe_lane(packet, lane, bs.wi, bs.f, bs.pdf).emission;
+                out.set_emission(lane, e);
             },
         );
     }
@@ -296,15 +303,15 @@ impl Estimator for MisEstimator<'_> {
     fn emission_weight_packet(
         &self,
         packet: &ShadingPacket,
-        probes: &[Probes; LANES],
+        probes: &ProbePacket,
         hits: &[Option<SurfaceHit>; LANES],
     ) -> [f32; LANES] {
         let mut at = SurfaceLanes::default();
         let mut light = [0u32; LANES];
         let mut mask = 0u32;
         for lane in 0..LANES {
-            if packet.mask >> lane & 1 != 0
-                && let (Some(_), Some(hit)) = (&probes[lane].emission, &hits[lane])
+            if (packet.mask & probes.emission_mask) >> lane & 1 != 0
+                && let Some(hit) = &hits[lane]
                 && let Some(e) = hit.emitter
             {
                 at.set(lane, &packet.light_ctx(lane), hit.p, e.local);
@@ -315,10 +322,9 @@ impl Estimator for MisEstimator<'_> {
         let p_light = self.lights.pdf_packet(&light, &at, mask);
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
-            if mask >> lane & 1 != 0
-                && let Some(probe) = &probes[lane].emission
-            {
-                *o = self.strategy.heuristic.weight(probe.pdf, p_light[lane]);
+            if (mask & probes.emission_mask) >> lane & 1 != 0 {
+                let pdf = probes.emission_pdf[lane];
+                *o = self.strategy.heuristic.weight(pdf, p_light[lane]);
             }
         }
         out
@@ -332,17 +338,16 @@ impl Estimator for MisEstimator<'_> {
     fn env_weight_packet(
         &self,
         packet: &ShadingPacket,
-        probes: &[Probes; LANES],
+        probes: &ProbePacket,
         dirs: &Soa3,
         mask: u32,
     ) -> [f32; LANES] {
         let p_light = self.lights.env_pdf_packet(packet, dirs, mask);
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
-            if mask >> lane & 1 != 0
-                && let Some(probe) = &probes[lane].emission
-            {
-                *o = self.strategy.heuristic.weight(probe.pdf, p_light[lane]);
+            if (mask & probes.emission_mask) >> lane & 1 != 0 {
+                let pdf = probes.emission_pdf[lane];
+                *o = self.strategy.heuristic.weight(pdf, p_light[lane]);
             }
         }
         out

@@ -22,7 +22,7 @@ use crate::math::{Frame, offset_ray_origin, offset_ray_origin_lanes};
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout, PacketDims};
 use crate::simd::{Soa3, V3, Vector, WIDTH};
-use crate::tracer::LANES;
+use crate::tracer::{LANES, RayPacket};
 use glam::Vec3;
 
 /// A surface point about to be shaded, with the normal flipped to the viewer's side (surfaces
@@ -255,6 +255,87 @@ impl Probes {
     }
 }
 
+/// A packet's [`Probes`], in lanes: the shadow segments and emission rays as the packets the
+/// renderer traces, with what each adds. Lane i of `shadow` (bit i of `shadow_mask`) and of
+/// `emission` (bit i of `emission_mask`) is lane i's probe; other lanes hold finite values
+/// that nothing reads. An estimator written over lanes fills the rows; [`Self::set`] stores a
+/// lane's `Probes`.
+#[derive(Clone, Debug, Default)]
+pub struct ProbePacket {
+    pub shadow: RayPacket,
+    pub shadow_value: Soa3,
+    pub shadow_mask: u32,
+    pub emission: RayPacket,
+    pub emission_weight: Soa3,
+    pub emission_pdf: [f32; LANES],
+    pub emission_mask: u32,
+}
+
+impl ProbePacket {
+    /// Lane `lane`'s probes become `p`.
+    #[inline(always)]
+    pub fn set(&mut self, lane: usize, p: Probes) {
+        let bit = 1 << lane;
+        match p.shadow {
+            Some(s) => {
+                self.shadow.set(lane, &s.ray);
+                self.shadow_value.set(lane, s.value);
+                self.shadow_mask |= bit;
+            }
+            None => self.shadow_mask &= !bit,
+        }
+        self.set_emission(lane, p.emission);
+    }
+
+    /// Lane `lane`'s emission probe becomes `e` (its shadow probe stays).
+    #[inline(always)]
+    pub fn set_emission(&mut self, lane: usize, e: Option<EmissionProbe>) {
+        let bit = 1 << lane;
+        match e {
+            Some(e) => {
+                self.emission.set(lane, &e.ray);
+                self.emission_weight.set(lane, e.weight);
+                self.emission_pdf[lane] = e.pdf;
+                self.emission_mask |= bit;
+            }
+            None => self.emission_mask &= !bit,
+        }
+    }
+
+    /// Lane `lane`'s probes.
+    #[inline(always)]
+    pub fn get(&self, lane: usize) -> Probes {
+        Probes {
+            shadow: self.shadow_probe(lane),
+            emission: self.emission_probe(lane),
+        }
+    }
+
+    #[inline(always)]
+    pub fn shadow_probe(&self, lane: usize) -> Option<ShadowProbe> {
+        (self.shadow_mask >> lane & 1 != 0).then(|| ShadowProbe {
+            ray: self.shadow.get(lane),
+            value: self.shadow_value.get(lane),
+        })
+    }
+
+    #[inline(always)]
+    pub fn emission_probe(&self, lane: usize) -> Option<EmissionProbe> {
+        (self.emission_mask >> lane & 1 != 0).then(|| EmissionProbe {
+            ray: self.emission.get(lane),
+            weight: self.emission_weight.get(lane),
+            pdf: self.emission_pdf[lane],
+        })
+    }
+
+    /// No lane has a probe.
+    #[inline(always)]
+    pub fn clear(&mut self) {
+        self.shadow_mask = 0;
+        self.emission_mask = 0;
+    }
+}
+
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowProbe {
     pub ray: Ray,
@@ -343,15 +424,17 @@ pub trait Estimator: Send + Sync {
 
     fn sample(&self, sp: &ShadingPoint, u: &mut Dims) -> Probes;
 
-    /// The probes of a packet of shading points, reading each lane's dimensions from `u` and
-    /// leaving `u` past the most any lane read (lanes without a point are left as they are). The default shades lane by lane through
+    /// The probes of a packet of shading points, written into `out` (cleared by the caller:
+    /// the lanes without a point get none), reading each lane's dimensions from `u` and
+    /// leaving `u` past the most any lane read. The default shades lane by lane through
     /// [`Self::sample`]; an estimator written over lanes overrides it, reading whole rows of
-    /// `u` ([`PacketDims::take`]) and the points' lanes ([`ShadingPacket::geo`]).
-    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut [Probes; LANES]) {
+    /// `u` ([`PacketDims::take`]) and the points' lanes ([`ShadingPacket::geo`]) and writing
+    /// the probes' rows.
+    fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
         let mut used = 0;
         for (lane, sp) in packet.points() {
             let mut d = u.lane(lane);
-            out[lane] = self.sample(&sp, &mut d);
+            out.set(lane, self.sample(&sp, &mut d));
             used = used.max(d.used());
         }
         u.skip(used);
@@ -373,15 +456,15 @@ pub trait Estimator: Send + Sync {
     fn emission_weight_packet(
         &self,
         packet: &ShadingPacket,
-        probes: &[Probes; LANES],
+        probes: &ProbePacket,
         hits: &[Option<SurfaceHit>; LANES],
     ) -> [f32; LANES] {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
-            if let (Some(probe), Some(hit)) = (&probes[lane].emission, &hits[lane])
+            if let (Some(probe), Some(hit)) = (probes.emission_probe(lane), &hits[lane])
                 && let Some(sp) = packet.point(lane)
             {
-                *o = self.emission_weight(&sp, probe, hit);
+                *o = self.emission_weight(&sp, &probe, hit);
             }
         }
         out
@@ -398,16 +481,16 @@ pub trait Estimator: Send + Sync {
     fn env_weight_packet(
         &self,
         packet: &ShadingPacket,
-        probes: &[Probes; LANES],
+        probes: &ProbePacket,
         _dirs: &Soa3,
         mask: u32,
     ) -> [f32; LANES] {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0
-                && let (Some(sp), Some(probe)) = (packet.point(lane), &probes[lane].emission)
+                && let (Some(sp), Some(probe)) = (packet.point(lane), probes.emission_probe(lane))
             {
-                *o = self.env_weight(&sp, probe);
+                *o = self.env_weight(&sp, &probe);
             }
         }
         out
