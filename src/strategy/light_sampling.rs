@@ -229,7 +229,8 @@ impl<'s> BoundLights<'s> {
         u: &mut PacketDims,
         mut emit: impl FnMut(usize, LightProbe),
     ) {
-        let (r, ls, light) = self.shadow_rays(packet, u);
+        let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
+        let r = self.shadow_rays(packet, u, &mut ls, &mut light);
         // Only f is evaluated lane by lane, from the lanes (no point is built).
         let mut valid = r.valid & packet.mask;
         while valid != 0 {
@@ -265,7 +266,8 @@ impl<'s> BoundLights<'s> {
         out: &mut ProbePacket,
         mut weight: impl FnMut(usize, &LocalBsdf, f32, Vec3, usize) -> f32,
     ) {
-        let (r, ls, light) = self.shadow_rays(packet, u);
+        let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
+        let r = self.shadow_rays(packet, u, &mut ls, &mut light);
         let valid = r.valid & packet.mask;
         let (o, origin) = (&mut out.shadow, &packet.geo.origin);
         (o.ox, o.oy, o.oz) = (origin.x, origin.y, origin.z);
@@ -293,7 +295,9 @@ impl<'s> BoundLights<'s> {
         &self,
         packet: &ShadingPacket,
         u: &mut PacketDims,
-    ) -> (ShadowRays, LaneSamples, [usize; LANES]) {
+        ls: &mut LaneSamples,
+        light: &mut [usize; LANES],
+    ) -> ShadowRays {
         let [u_select, u0, u1, u2] = u.take::<4>();
         // The points and their sample numbers, as rows (no lane is moved on its own).
         let q = LaneQuery {
@@ -305,12 +309,11 @@ impl<'s> BoundLights<'s> {
             pmf: [0.0; WIDTH],
             geo: &packet.geo,
         };
-        let mut light = [usize::MAX; LANES];
         let chosen;
         // One dynamic call per packet, not per lane, where the choice cannot vary (one light).
         if let Some((i, pmf)) = self.selector.constant() {
             chosen = packet.mask;
-            light = [i; LANES];
+            *light = [i; LANES];
             x.pmf = [pmf; WIDTH];
         } else {
             let mut c = 0u32;
@@ -332,7 +335,6 @@ impl<'s> BoundLights<'s> {
         }
         // Lights with a kernel over lanes of different lights (mesh triangles) hand over their
         // records; each such kernel samples all its lanes at once.
-        let mut ls = LaneSamples::default();
         let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
         let mut records: Option<Box<LaneRecords>> = None;
         let mut with_kernel = 0u32;
@@ -360,7 +362,7 @@ impl<'s> BoundLights<'s> {
             }
             rest &= !mask;
             let records = records.as_deref().expect("records for lanes with a kernel");
-            (k.sample)(self.isa, records, &q, mask, &self.methods, &mut ls);
+            (k.sample)(self.isa, records, &q, mask, &self.methods, ls);
         }
         // Each other chosen light samples its lanes at once.
         let mut rest = chosen & !with_kernel;
@@ -370,7 +372,7 @@ impl<'s> BoundLights<'s> {
             rest &= !mask;
             self.lights
                 .get(i)
-                .sample_lanes(self.isa, &q, mask, &self.methods, &mut ls);
+                .sample_lanes(self.isa, &q, mask, &self.methods, ls);
         }
         struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes<'a>);
         impl simd::Kernel for Kernel<'_> {
@@ -380,7 +382,7 @@ impl<'s> BoundLights<'s> {
                 shadow_lanes::<L::V>(self.0, self.1, self.2)
             }
         }
-        (simd::run(self.isa, Kernel(&q, &ls, &x)), ls, light)
+        simd::run(self.isa, Kernel(&q, ls, &x))
     }
 
     /// The pdf with which [`Self::probe`] samples the direction to point `q` of part `local`
