@@ -345,7 +345,10 @@ impl<'s> BoundLights<'s> {
             let lane = rest.trailing_zeros() as usize;
             rest &= rest - 1;
             if let Some((k, r)) = self.lights.get(light[lane]).lane_record(&self.methods) {
-                let records = records.get_or_insert_with(|| [[0.0; LANES]; LANE_RECORD]);
+                if records.is_none() {
+                    records = Some([[0.0; LANES]; LANE_RECORD]);
+                }
+                let records = records.as_mut().expect("records made above");
                 for (field, v) in records.iter_mut().zip(r) {
                     field[lane] = v;
                 }
@@ -370,7 +373,7 @@ impl<'s> BoundLights<'s> {
         let mut rest = chosen & !with_kernel;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
-            let mask = lanes_holding(&light, i) & chosen;
+            let mask = lanes_holding(light, i) & chosen;
             rest &= !mask;
             self.lights
                 .get(i)
