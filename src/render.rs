@@ -191,9 +191,7 @@ impl<'a> Renderer<'a> {
                 .zip(tiles.par_iter())
                 .for_each_init(TileScratch::default, |scratch, ((sum, m2), tile)| {
                     let radiance = this.shading_phase(tile, scratch);
-                    for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
-                        update.add(s, m, [l.x as f64, l.y as f64, l.z as f64]);
-                    }
+                    update.add_tile(this.isa, sum, m2, &radiance);
                 });
         } else {
             let this = &*self;
@@ -206,9 +204,7 @@ impl<'a> Renderer<'a> {
                     |(tile, scratch), (t, (sum, m2))| {
                         this.camera_phase(&layout, t, stream, tile, scratch);
                         let radiance = this.shading_phase(tile, scratch);
-                        for ((s, m), l) in sum.iter_mut().zip(m2.iter_mut()).zip(radiance.iter()) {
-                            update.add(s, m, [l.x as f64, l.y as f64, l.z as f64]);
-                        }
+                        update.add_tile(this.isa, sum, m2, &radiance);
                     },
                 );
         }
