@@ -16,7 +16,8 @@ use dibench::scene::Scene;
 use dibench::simd::{Isa, Soa3};
 use dibench::strategy::light_sampling::{BoundLights, LightProbe};
 use dibench::strategy::{
-    EmissionProbe, ProbePacket, Probes, ShadingPacket, ShadingPoint, ShadowProbe, by_name,
+    EmissionProbe, Estimator, ProbePacket, Probes, ShadingPacket, ShadingPoint, ShadowProbe,
+    by_name,
 };
 use dibench::tracer::LANES;
 use glam::Vec3;
@@ -177,6 +178,25 @@ fn stale_probes() -> ProbePacket {
     p
 }
 
+/// A packet's points one by one, and its probes as the estimator writes them (into a stale
+/// probe packet) and lane by lane.
+#[allow(clippy::type_complexity)]
+fn sampled<'a>(
+    est: &dyn Estimator,
+    packet: &ShadingPacket<'a>,
+    values: &LaneValues,
+) -> (
+    [Option<ShadingPoint<'a>>; LANES],
+    ProbePacket,
+    [Probes; LANES],
+) {
+    let points = std::array::from_fn(|l| packet.point(l));
+    let mut packed = stale_probes();
+    est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut packed);
+    let probes = std::array::from_fn(|lane| packed.get(lane));
+    (points, packed, probes)
+}
+
 /// Debug text prints every float by its shortest round trip, so equal text is equal bits.
 fn same<T: std::fmt::Debug>(a: &T, b: &T) -> bool {
     format!("{a:?}") == format!("{b:?}")
@@ -323,11 +343,8 @@ fn env_weights_over_lanes_are_the_scalar_ones() {
                 continue;
             };
             for (packet, values) in &packets {
-                let points: &[Option<ShadingPoint>; LANES] =
-                    &std::array::from_fn(|l| packet.point(l));
-                let mut packed = stale_probes();
-                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut packed);
-                let probes: [Probes; LANES] = std::array::from_fn(|lane| packed.get(lane));
+                let (points, packed, probes) = sampled(est.as_ref(), packet, values);
+                let points = &points;
                 let mut dirs = Soa3::default();
                 let mut mask = 0u32;
                 for lane in 0..LANES {
@@ -377,11 +394,8 @@ fn emission_weights_over_lanes_are_the_scalar_ones() {
                 continue;
             };
             for (packet, values) in &packets {
-                let points: &[Option<ShadingPoint>; LANES] =
-                    &std::array::from_fn(|l| packet.point(l));
-                let mut packed = stale_probes();
-                est.sample_packet(packet, &mut PacketDims::new(values, 0, DIMS), &mut packed);
-                let probes: [Probes; LANES] = std::array::from_fn(|lane| packed.get(lane));
+                let (points, packed, probes) = sampled(est.as_ref(), packet, values);
+                let points = &points;
                 let hits: [Option<SurfaceHit>; LANES] = std::array::from_fn(|lane| {
                     let e = probes[lane]
                         .emission

@@ -163,6 +163,29 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
     out
 }
 
+/// Each shadow lane's unweighted value f·L·cos θ/pdf, handed to `each(lane, bsdf, local,
+/// value)` with the lane's material and the direction in its shading frame: only f is
+/// evaluated lane by lane, from the packet's rows (no point is built).
+#[inline(always)]
+fn shadow_values(
+    packet: &ShadingPacket,
+    r: &ShadowRays,
+    ls: &LaneSamples,
+    mut each: impl FnMut(usize, &LocalBsdf, Vec3, Vec3),
+) {
+    let mut valid = r.valid & packet.mask;
+    while valid != 0 {
+        let lane = valid.trailing_zeros() as usize;
+        valid &= valid - 1;
+        let bsdf = packet
+            .local_bsdf(lane)
+            .expect("a valid shadow lane has a point");
+        let local = r.local.get(lane);
+        let value = bsdf.eval_local(local) * ls.radiance.get(lane) * r.factor[lane];
+        each(lane, &bsdf, local, value);
+    }
+}
+
 impl<'s> BoundLights<'s> {
     /// `methods` as the scene can use them, in the view's environment representation; Err
     /// when the selector cannot select (no light with positive power, too many lights).
@@ -231,26 +254,17 @@ impl<'s> BoundLights<'s> {
     ) {
         let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
         let r = self.shadow_rays(packet, u, &mut ls, &mut light);
-        // Only f is evaluated lane by lane, from the lanes (no point is built).
-        let mut valid = r.valid & packet.mask;
-        while valid != 0 {
-            let lane = valid.trailing_zeros() as usize;
-            valid &= valid - 1;
-            let bsdf = packet
-                .local_bsdf(lane)
-                .expect("a valid shadow lane has a point");
-            let local = r.local.get(lane);
+        shadow_values(packet, &r, &ls, |lane, _, local, value| {
             let mut sample = ls
                 .get(lane)
                 .expect("a valid shadow lane has a light sample");
             sample.pdf = r.pdf[lane];
-            let value = bsdf.eval_local(local) * sample.radiance * r.factor[lane];
             let ray = Ray::new(packet.geo.origin.get(lane), r.dir.get(lane), r.tmax[lane]);
             emit(
                 lane,
                 (ShadowProbe { ray, value }, sample, local, light[lane]),
             );
-        }
+        });
     }
 
     /// [`Self::probe_packet`]'s shadow probes written into `out`'s shadow rows (the rays as
@@ -274,18 +288,10 @@ impl<'s> BoundLights<'s> {
         (o.dx, o.dy, o.dz) = (r.dir.x, r.dir.y, r.dir.z);
         o.tmax = r.tmax;
         out.shadow_mask = valid;
-        let mut rest = valid;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            let bsdf = packet
-                .local_bsdf(lane)
-                .expect("a valid shadow lane has a point");
-            let local = r.local.get(lane);
-            let value = bsdf.eval_local(local) * ls.radiance.get(lane) * r.factor[lane];
-            let w = weight(lane, &bsdf, r.pdf[lane], local, light[lane]);
+        shadow_values(packet, &r, &ls, |lane, bsdf, local, value| {
+            let w = weight(lane, bsdf, r.pdf[lane], local, light[lane]);
             out.shadow_value.set(lane, value * w);
-        }
+        });
     }
 
     /// The shadow rays of a packet's light samples: the lights chosen lane by lane, each
