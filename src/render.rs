@@ -44,7 +44,7 @@ pub struct Renderer<'a> {
 /// (rayon's `for_each_init`): 2 KiB of sample values are not cleared and copied per tile.
 struct CameraTile<'a> {
     radiance: [Vec3; LANES],
-    /// The shading points, as points and in lanes (the shading kernel writes the lanes).
+    /// The shading points, in lanes (the shading kernel writes them).
     packet: ShadingPacket<'a>,
     values: LaneValues,
 }
@@ -366,7 +366,7 @@ impl<'a> Renderer<'a> {
         probes.clear();
         self.estimator
             .sample_packet(&tile.packet, &mut dims, probes);
-        // The estimator leaves the lanes without a point without probes.
+        // Only lanes with a point are traced, whatever an estimator left in the others.
         let shadow_mask = (probes.shadow_mask & tile.packet.mask) as LaneMask;
         let emit_mask = (probes.emission_mask & tile.packet.mask) as LaneMask;
         if shadow_mask != 0 {
@@ -406,12 +406,12 @@ impl<'a> Renderer<'a> {
             let mut surfaces: [Option<SurfaceHit>; LANES] = [None; LANES];
             let mut le = [Vec3::ZERO; LANES];
             for lane in 0..LANES {
-                let Some(probe) = probes
-                    .emission_probe(lane)
-                    .filter(|_| emit_mask >> lane & 1 != 0)
-                else {
+                if emit_mask >> lane & 1 == 0 {
                     continue;
-                };
+                }
+                let probe = probes
+                    .emission_probe(lane)
+                    .expect("an emission lane has a probe");
                 match ehits.get(lane) {
                     Some(hit) => {
                         if let Some((surf, l)) = emitted_at(&self.view, &probe, &hit) {

@@ -370,6 +370,39 @@ fn ambient_occlusion_under_a_sphere() {
     }
 }
 
+/// A point light beside an emitting rectangle, so MIS applies: the BSDF half cannot reach the
+/// point light, so its light samples must weigh 1, and every strategy must find both lights'
+/// sum (the point light's intensity is 0.4·L per channel, so one irradiance per unit L holds).
+#[test]
+fn point_light_beside_an_area_light_sums() {
+    let k = 0.4;
+    let power = RADIANCE.map(|l| (4.0 * PI * k) as f32 * l);
+    let body = format!(
+        "[[point_light]]\nposition = [0.3, 1.7, -0.4]\npower = {}\n\
+         [[quad]]\ncorner = [-1.0, 2.0, -0.5]\nedge_u = [0.5, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.6]\nmaterial = \"m\"\nemission = {}\n",
+        rgb(power),
+        rgb(RADIANCE)
+    );
+    let scene = prepare(&body, &[]);
+    let e = point_irradiance(DVec3::ZERO, DVec3::Y, DVec3::new(0.3, 1.7, -0.4), k)
+        + polygon_irradiance(
+            DVec3::ZERO,
+            DVec3::Y,
+            &[
+                DVec3::new(-1.0, 2.0, -0.5),
+                DVec3::new(-1.0, 2.0, 0.1),
+                DVec3::new(-0.5, 2.0, 0.1),
+                DVec3::new(-0.5, 2.0, -0.5),
+            ],
+            1.0,
+        );
+    assert!(
+        applies(by_name("mis-power").unwrap().as_ref(), &scene).is_ok(),
+        "MIS applies beside an emitting surface"
+    );
+    check_all(&scene, DVec3::ZERO, DVec3::Y, e, 61);
+}
+
 /// Spot and directional lights are deterministic estimates: exact to f32 precision.
 #[test]
 fn spot_and_directional_lights_are_exact() {

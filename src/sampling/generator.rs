@@ -32,6 +32,14 @@ pub const MAX_DIMENSIONS: usize = 32;
 /// profile, docs/tracer.md, stop 36). [`Dims::lane`] reads one lane's dimensions.
 pub type LaneValues = [[f32; WIDTH]; MAX_DIMENSIONS];
 
+/// Stores one sample's dimensions `values` (in order, from dimension 0) as lane `lane` of a
+/// packet's dimension-major values.
+pub fn set_lane(out: &mut LaneValues, lane: usize, values: &[f32]) {
+    for (row, &v) in out.iter_mut().zip(values) {
+        row[lane] = v;
+    }
+}
+
 /// What a generator knows about the render it serves, fixed for the whole render: the full
 /// layout (the camera's pair first, then the strategy's), the sample count per pixel when it
 /// is known up front (a fixed `--spp`; None under a time budget), and the image size (a
@@ -103,9 +111,7 @@ pub trait SampleGenerator: Send + Sync {
         for (lane, key) in keys.iter().enumerate() {
             if lanes & (1 << lane) != 0 {
                 self.fill(setup, *key, &mut row[..dims]);
-                for (o, &v) in out.iter_mut().zip(&row[..dims]) {
-                    o[lane] = v;
-                }
+                set_lane(out, lane, &row[..dims]);
             }
         }
     }
@@ -326,9 +332,7 @@ pub(crate) fn assert_every_isa_fills_as_one_sample(
     for (lane, k) in keys.iter().enumerate() {
         let mut row = [0.0f32; MAX_DIMENSIONS];
         g.fill(setup, *k, &mut row[..dims]);
-        for (w, &v) in want.iter_mut().zip(&row[..dims]) {
-            w[lane] = v;
-        }
+        set_lane(&mut want, lane, &row[..dims]);
     }
     let bits = |a: &LaneValues| {
         a[..dims]
@@ -374,6 +378,34 @@ mod tests {
                 assert_eq!(all.get_1d(), at(d));
             }
         }
+    }
+
+    /// A packet's cursor hands out rows in layout order from its first dimension, a lane's
+    /// `Dims` from where the cursor stands, and refuses to move past its last dimension.
+    #[test]
+    fn a_packet_reads_its_dimensions_as_rows_in_order() {
+        let mut v: LaneValues = [[0.0; WIDTH]; MAX_DIMENSIONS];
+        for (d, row) in v.iter_mut().enumerate() {
+            for (lane, x) in row.iter_mut().enumerate() {
+                *x = (d * 100 + lane) as f32;
+            }
+        }
+        let mut u = PacketDims::new(&v, 2, 8);
+        assert_eq!(u.remaining(), 6);
+        let [a] = u.take::<1>();
+        assert_eq!(a, &v[2]);
+        let [b, c] = u.take::<2>();
+        assert_eq!((b, c), (&v[3], &v[4]));
+        assert_eq!(
+            u.lane(7).get_1d(),
+            v[5][7],
+            "a lane starts where the packet stands"
+        );
+        u.skip(2);
+        assert_eq!(u.take::<1>()[0], &v[7]);
+        assert_eq!(u.remaining(), 0);
+        let past = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| u.skip(1)));
+        assert!(past.is_err(), "a packet read past its layout");
     }
 
     /// Every generator's packet fill gives each active lane exactly its single-sample fill (the

@@ -120,7 +120,7 @@ mod tests {
 mod lane_tests {
     use super::*;
     use crate::sampling::Layout;
-    use crate::sampling::generator::MAX_DIMENSIONS;
+    use crate::sampling::generator::{MAX_DIMENSIONS, set_lane};
 
     /// Every ISA's build of the packet fill gives the numbers of one stream at a time, for
     /// lanes of different strategies too (integer lanes: nothing may differ).
@@ -138,9 +138,7 @@ mod lane_tests {
         for (lane, k) in keys.iter().enumerate() {
             let mut row = [0.0f32; MAX_DIMENSIONS];
             INDEPENDENT.fill(&setup, *k, &mut row[..dims]);
-            for (w, &v) in want.iter_mut().zip(&row[..dims]) {
-                w[lane] = v;
-            }
+            set_lane(&mut want, lane, &row[..dims]);
         }
         for isa in Isa::available() {
             let mut got = [[0.0f32; WIDTH]; MAX_DIMENSIONS];

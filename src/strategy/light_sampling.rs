@@ -269,8 +269,8 @@ impl<'s> BoundLights<'s> {
 
     /// [`Self::probe_packet`]'s shadow probes written into `out`'s shadow rows (the rays as
     /// the kernel computed them, no lane moved on its own), each value times
-    /// `weight(lane, bsdf, pdf, local, light)` (1 for plain light sampling, the MIS weight for
-    /// MIS: `value · w`, as the scalar path's `value *= w`): the lane's material, the light
+    /// `weight(bsdf, pdf, local, light)` (1 for plain light sampling, the MIS weight for MIS:
+    /// `value · w`, as the scalar path's `value *= w`): the lane's material, the light
     /// sample's pdf with the selection's, its direction in the shading frame and the light.
     #[inline(always)]
     pub fn probe_packet_rows(
@@ -278,7 +278,7 @@ impl<'s> BoundLights<'s> {
         packet: &ShadingPacket,
         u: &mut PacketDims,
         out: &mut ProbePacket,
-        mut weight: impl FnMut(usize, &LocalBsdf, f32, Vec3, usize) -> f32,
+        mut weight: impl FnMut(&LocalBsdf, f32, Vec3, usize) -> f32,
     ) {
         let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
         let r = self.shadow_rays(packet, u, &mut ls, &mut light);
@@ -289,7 +289,7 @@ impl<'s> BoundLights<'s> {
         o.tmax = r.tmax;
         out.shadow_mask = valid;
         shadow_values(packet, &r, &ls, |lane, bsdf, local, value| {
-            let w = weight(lane, bsdf, r.pdf[lane], local, light[lane]);
+            let w = weight(bsdf, r.pdf[lane], local, light[lane]);
             out.shadow_value.set(lane, value * w);
         });
     }
@@ -537,7 +537,6 @@ impl Estimator for LightEstimator<'_> {
     }
 
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
-        self.0
-            .probe_packet_rows(packet, u, out, |_, _, _, _, _| 1.0);
+        self.0.probe_packet_rows(packet, u, out, |_, _, _, _| 1.0);
     }
 }

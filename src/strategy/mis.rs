@@ -236,18 +236,19 @@ impl MisEstimator<'_> {
     /// The light probe with its MIS weight.
     fn weighted(&self, bsdf: &LocalBsdf, light: Option<LightProbe>) -> Option<ShadowProbe> {
         light.map(|(mut probe, ls, local, light)| {
-            // A delta light is reachable by light sampling only: its weight is 1.
-            if !self.lights.lights.get(light).is_delta() {
-                probe.value *= self.light_weight(bsdf, ls.pdf, local);
-            }
+            probe.value *= self.light_weight(bsdf, ls.pdf, local, light);
             probe
         })
     }
 
-    /// The MIS weight of a light sample of pdf `pdf` (selection included) in direction
-    /// `local` (shading frame) from a point of material `bsdf`.
+    /// The MIS weight of a sample of light `light` with pdf `pdf` (selection included) in
+    /// direction `local` (shading frame) from a point of material `bsdf`. A delta light is
+    /// reachable by light sampling only: its weight is 1 (`value · 1` is `value`).
     #[inline(always)]
-    fn light_weight(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3) -> f32 {
+    fn light_weight(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3, light: usize) -> f32 {
+        if self.lights.lights.get(light).is_delta() {
+            return 1.0;
+        }
         let p_bsdf = bsdf.pdf_local(local, self.strategy.sampling);
         self.strategy.heuristic.weight(pdf, p_bsdf)
     }
@@ -272,15 +273,10 @@ impl Estimator for MisEstimator<'_> {
     }
 
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
-        // Each light probe weighted as its value is made; a delta light's weight is 1
-        // (`value · 1` is `value`, as in the scalar path, which leaves it alone).
+        // Each light probe weighted as its value is made.
         self.lights
-            .probe_packet_rows(packet, u, out, |_, bsdf, pdf, local, light| {
-                if self.lights.lights.get(light).is_delta() {
-                    1.0
-                } else {
-                    self.light_weight(bsdf, pdf, local)
-                }
+            .probe_packet_rows(packet, u, out, |bsdf, pdf, local, light| {
+                self.light_weight(bsdf, pdf, local, light)
             });
         bsdf_sample_packet(
             self.lights.isa,
@@ -322,7 +318,7 @@ impl Estimator for MisEstimator<'_> {
         let p_light = self.lights.pdf_packet(&light, &at, mask);
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
-            if (mask & probes.emission_mask) >> lane & 1 != 0 {
+            if mask >> lane & 1 != 0 {
                 let pdf = probes.emission_pdf[lane];
                 *o = self.strategy.heuristic.weight(pdf, p_light[lane]);
             }

@@ -461,7 +461,8 @@ pub trait Estimator: Send + Sync {
     ) -> [f32; LANES] {
         let mut out = [1.0f32; LANES];
         for (lane, o) in out.iter_mut().enumerate() {
-            if let (Some(probe), Some(hit)) = (probes.emission_probe(lane), &hits[lane])
+            if let Some(hit) = &hits[lane]
+                && let Some(probe) = probes.emission_probe(lane)
                 && let Some(sp) = packet.point(lane)
             {
                 *o = self.emission_weight(&sp, &probe, hit);
