@@ -69,3 +69,43 @@ fn rays_writes_csv() {
         assert!(csv.contains(&format!("packet,portable,{class}")), "{csv}");
     }
 }
+
+/// `--class` times only the named ray classes, and an unknown one is an error naming the
+/// flag and the known classes.
+#[test]
+fn class_picks_the_ray_classes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    let (ok, err) = run(&[
+        "rays",
+        "cornell",
+        "--out",
+        out,
+        "--size",
+        "16",
+        "--rounds",
+        "1",
+        "--class",
+        "shadow_distant,primary",
+    ]);
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(dir.path().join("cornell/rays.csv")).unwrap();
+    let classes: std::collections::BTreeSet<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(3).unwrap())
+        .collect();
+    assert_eq!(
+        classes.into_iter().collect::<Vec<_>>(),
+        ["primary", "shadow_distant"],
+        "{csv}"
+    );
+    let (ok, err) = run(&["rays", "cornell", "--out", out, "--class", "shadow"]);
+    assert!(!ok, "an unknown class was accepted");
+    assert!(
+        err.contains("--class") && err.contains("unknown ray class `shadow`"),
+        "{err}"
+    );
+    assert!(err.contains("shadow_area"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}

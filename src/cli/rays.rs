@@ -1,8 +1,8 @@
 //! `dibench rays`: ray throughput of each backend (and ISA) on fixed ray sets.
 
 use super::{load, parse_threads, pool};
-use crate::error::Result;
-use crate::harness::rays;
+use crate::error::{Error, Result};
+use crate::harness::{rays, raysets};
 use crate::simd::Isa;
 use clap::Args;
 use std::path::PathBuf;
@@ -32,6 +32,10 @@ pub struct RaysArgs {
     pub rounds: usize,
     #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
+    /// Comma-separated ray classes to time (primary, shadow_area, shadow_distant, incoherent;
+    /// default: all four).
+    #[arg(long, value_delimiter = ',')]
+    pub class: Vec<String>,
 }
 
 fn parse_rounds(s: &str) -> std::result::Result<usize, String> {
@@ -45,6 +49,15 @@ pub fn run(a: RaysArgs) -> Result<()> {
     for b in &a.backend {
         if !rays::BACKENDS.contains(&b.as_str()) {
             return Err(rays::unknown_backend(b));
+        }
+    }
+    for c in &a.class {
+        if !raysets::CLASSES.iter().any(|(name, _)| name == c) {
+            let known: Vec<&str> = raysets::CLASSES.iter().map(|(name, _)| *name).collect();
+            return Err(Error::Usage(format!(
+                "--class: unknown ray class `{c}` (known: {})",
+                known.join(", ")
+            )));
         }
     }
     let isas = match (&a.isa, std::env::var("DIBENCH_ISA")) {
@@ -62,7 +75,10 @@ pub fn run(a: RaysArgs) -> Result<()> {
         || format!("--size {}", a.size),
         crate::bounded::bytes(a.size as u64 * a.size as u64, 256),
     )?;
-    let sets = rays::generate(&scene, a.size, a.seed);
+    let mut sets = rays::generate(&scene, a.size, a.seed);
+    if !a.class.is_empty() {
+        sets.retain(|s| a.class.iter().any(|c| c == s.class));
+    }
     let subjects = rays::subjects(&scene, &a.backend, &isas)?;
     let rows = pool.install(|| rays::measure(&name, &sets, &subjects, a.rounds, threads));
     crate::output::write_csv(&path, &rows)?;
