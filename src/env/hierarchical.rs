@@ -23,10 +23,12 @@ pub struct HierarchicalWarp {
     n: usize,
     /// Cumulative tile sums, starting at 0 (tiles + 1 entries, non-decreasing).
     tile_cdf: Vec<f32>,
-    /// Per tile, the levels of side 2, 4, …, n (row-major), coarsest first; tile t's levels
-    /// start at t·`block`.
-    pyramid: Vec<f32>,
-    /// Floats per tile: 4 + 16 + … + n².
+    /// Per tile, the levels of side 2, 4, …, n, coarsest first, each as the 2×2 quads of its
+    /// parent level's nodes in row-major order, a quad's texels as (x, y) = (0, 0), (1, 0),
+    /// (0, 1), (1, 1): a descent step reads one quad, 16 bytes in one cache line, where a
+    /// row-major level spread the four over two rows. Tile t's levels start at quad t·`block`.
+    pyramid: Vec<[f32; 4]>,
+    /// Quads per tile: 1 + 4 + … + (n/2)².
     block: usize,
 }
 
@@ -49,7 +51,7 @@ impl HierarchicalWarp {
             "hierarchical warping needs a power-of-two tile"
         );
         let width = tiles * n;
-        let block = (4 * n * n - 4) / 3;
+        let block = (n * n - 1) / 3;
         let mut pyramid = Vec::with_capacity(tiles * block);
         let mut tile_cdf = vec![0.0f32];
         let mut running = 0.0f64;
@@ -81,7 +83,7 @@ impl HierarchicalWarp {
             running += levels.last().unwrap()[0];
             tile_cdf.push(running as f32);
             for level in levels.iter().rev().skip(1) {
-                pyramid.extend(level.iter().map(|&w| w as f32));
+                pyramid.extend(quads(level));
             }
         }
         (running > 0.0).then_some(HierarchicalWarp {
@@ -126,18 +128,14 @@ impl HierarchicalWarp {
                 .min(V::splat(ONE_MINUS_EPSILON));
         }
         let (mut x, mut y) = ([0u32; N], [0u32; N]);
-        let (mut s, mut offset) = (2usize, 0usize);
-        while s <= self.n {
+        // `half` is the parent level's side: the quad of node (x, y) is its row-major index.
+        let (mut half, mut offset) = (1usize, 0usize);
+        while half < self.n {
             let mut at = [0usize; N];
             for i in 0..N {
-                at[i] = tile[i] * self.block + offset + 2 * y[i] as usize * s + 2 * x[i] as usize;
+                at[i] = tile[i] * self.block + offset + y[i] as usize * half + x[i] as usize;
             }
-            let (c00, c10, c01, c11) = (
-                gather::<V, N>(&self.pyramid, &at, 0),
-                gather::<V, N>(&self.pyramid, &at, 1),
-                gather::<V, N>(&self.pyramid, &at, s),
-                gather::<V, N>(&self.pyramid, &at, s + 1),
-            );
+            let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at);
             let (right, u0n) = split(c00.add(c01), c10.add(c11), u0);
             let (top, bottom) = (V::select(right, c10, c00), V::select(right, c11, c01));
             let (down, u1n) = split(top, bottom, u1);
@@ -146,8 +144,8 @@ impl HierarchicalWarp {
                 y[i] = 2 * y[i] + (down >> i & 1);
             }
             (u0, u1) = (u0n, u1n);
-            offset += s * s;
-            s *= 2;
+            offset += half * half;
+            half *= 2;
         }
         let mut col = x;
         for i in 0..N {
@@ -162,15 +160,40 @@ impl HierarchicalWarp {
     }
 }
 
-/// Lane i = `values[at[i] + d]`. A function, not a closure: a closure is not always inlined
-/// into the ISA's entry, and outside it its vector load is a call.
+/// The quads `quads[at[i]]` of N lanes as four vectors, one per texel of the quad. A
+/// function, not a closure: a closure is not always inlined into the ISA's entry, and outside
+/// it its vector load is a call.
 #[inline(always)]
-fn gather<V: Vector<N>, const N: usize>(values: &[f32], at: &[usize; N], d: usize) -> V {
-    let mut a = [0.0f32; N];
+fn gather<V: Vector<N>, const N: usize>(quads: &[[f32; 4]], at: &[usize; N]) -> [V; 4] {
+    let mut a = [[0.0f32; N]; 4];
     for i in 0..N {
-        a[i] = values[at[i] + d];
+        let q = quads[at[i]];
+        for k in 0..4 {
+            a[k][i] = q[k];
+        }
     }
-    V::load(&a)
+    [
+        V::load(&a[0]),
+        V::load(&a[1]),
+        V::load(&a[2]),
+        V::load(&a[3]),
+    ]
+}
+
+/// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in
+/// f32.
+fn quads(level: &[f64]) -> impl Iterator<Item = [f32; 4]> + '_ {
+    let s = level.len().isqrt();
+    let h = s / 2;
+    (0..h * h).map(move |k| {
+        let (x, y) = (2 * (k % h), 2 * (k / h));
+        [
+            level[y * s + x] as f32,
+            level[y * s + x + 1] as f32,
+            level[(y + 1) * s + x] as f32,
+            level[(y + 1) * s + x + 1] as f32,
+        ]
+    })
 }
 
 /// Per lane, the second half (bit set) with probability b/(a + b), else the first, and u
@@ -251,13 +274,17 @@ mod tests {
         let warp = HierarchicalWarp::new(&w, tiles, n).unwrap();
         let mut mirrored = warp.clone();
         for t in 0..tiles {
-            let (mut s, mut off) = (2, t * warp.block);
-            while s <= n {
-                for row in mirrored.pyramid[off..off + s * s].chunks_exact_mut(s) {
+            let (mut half, mut off) = (1, t * warp.block);
+            while half < n {
+                // Each row of quads reversed, and each quad's columns swapped.
+                for row in mirrored.pyramid[off..off + half * half].chunks_exact_mut(half) {
                     row.reverse();
+                    for q in row {
+                        *q = [q[1], q[0], q[3], q[2]];
+                    }
                 }
-                off += s * s;
-                s *= 2;
+                off += half * half;
+                half *= 2;
             }
         }
         assert!(frequency_mismatch(&mirrored, &w).is_some());
