@@ -433,7 +433,13 @@ impl<V: Vector<WIDTH>> Prep<V> {
     /// A packet's visit of inner node `i` with the lanes in `m`: counted, its children tested
     /// and the hit ones pushed.
     #[inline(always)]
-    fn visit<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    fn visit<
+        W: Vector<NARROW>,
+        const FAULT: u32,
+        const ORIGIN: bool,
+        const SIGNS: bool,
+        const ANY: bool,
+    >(
         &self,
         tr: &PacketTracer,
         i: u32,
@@ -445,7 +451,7 @@ impl<V: Vector<WIDTH>> Prep<V> {
         stats.packet_nodes += 1;
         stats.packet_lanes += m.count_ones() as u64;
         let n = &tr.wide.nodes[i as usize];
-        stats.frustum_nodes += self.push_children::<W, FAULT, ORIGIN, SIGNS>(
+        stats.frustum_nodes += self.push_children::<W, FAULT, ORIGIN, SIGNS, ANY>(
             &tr.wide,
             n,
             m,
@@ -459,7 +465,13 @@ impl<V: Vector<WIDTH>> Prep<V> {
     /// entry distance of each child's first lane (of the hull, when the interval test alone
     /// decides: then it returns true).
     #[inline(always)]
-    fn push_children<W: Vector<NARROW>, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
+    fn push_children<
+        W: Vector<NARROW>,
+        const FAULT: u32,
+        const ORIGIN: bool,
+        const SIGNS: bool,
+        const ANY: bool,
+    >(
         &self,
         wide: &Wide,
         n: &Node,
@@ -511,9 +523,21 @@ impl<V: Vector<WIDTH>> Prep<V> {
                     continue;
                 }
                 // The smallest entry distance of the child's lanes: lanes whose closest hit
-                // is nearer by the time it is popped skip it.
-                let entry = V::select(hit, V::load(&near), inf).reduce_min();
-                (hit, entry, near[hit.trailing_zeros() as usize])
+                // is nearer by the time it is popped skip it. Occlusion has no closest hit
+                // to cull by, so it skips the reduction.
+                let entry = if ANY {
+                    0.0
+                } else {
+                    V::select(hit, V::load(&near), inf).reduce_min()
+                };
+                // Occlusion orders children by the hull's entry distance where the interval
+                // test ran (the near rows then need not be read back).
+                let key = if ANY && SIGNS {
+                    hull_near[i]
+                } else {
+                    near[hit.trailing_zeros() as usize]
+                };
+                (hit, entry, key)
             };
             if hit != 0 {
                 let key = if FAULT & FAULT_FAR_FIRST != 0 {
@@ -724,7 +748,7 @@ fn closest<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         match c.kind() {
             Kind::Inner(i) => {
                 let cull = L::V::load(&best.t).mul(L::V::splat(CULL_SCALE));
-                p.visit::<L::W, FAULT, ORIGIN, SIGNS>(tr, i, m, cull, &mut stack, stats);
+                p.visit::<L::W, FAULT, ORIGIN, SIGNS, false>(tr, i, m, cull, &mut stack, stats);
             }
             Kind::Block(b, count) => {
                 stats.leaves += 1;
@@ -840,7 +864,7 @@ fn occluded<L: Lanes, const FAULT: u32, const ORIGIN: bool, const SIGNS: bool>(
         } else {
             match c.kind() {
                 Kind::Inner(i) => {
-                    p.visit::<L::W, FAULT, ORIGIN, SIGNS>(tr, i, m, cull, &mut stack, stats);
+                    p.visit::<L::W, FAULT, ORIGIN, SIGNS, true>(tr, i, m, cull, &mut stack, stats);
                 }
                 Kind::Block(b, count) => {
                     stats.leaves += 1;
