@@ -282,6 +282,12 @@ impl Bsdf {
         &self.lobes
     }
 
+    /// kd when the material is one built-in Lambert lobe of kd (f = kd/π, sampled by cosine):
+    /// what callers that evaluate it over lanes need.
+    pub fn diffuse(&self) -> Option<Vec3> {
+        self.diffuse
+    }
+
     /// BSDF sampling is cosine sampling for this material.
     pub fn is_cosine_sampled(&self) -> bool {
         self.cosine_sampled

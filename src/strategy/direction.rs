@@ -3,8 +3,11 @@
 //! mixture, by the strategy's [`BsdfSampling`] part: lobe selection and GGX sampler).
 //! Estimator f·Le·cos θ / pdf. None of them can reach a delta light.
 
-use super::{EmissionProbe, Estimator, ProbePacket, Probes, ShadingPacket, ShadingPoint, Strategy};
-use crate::bsdf::{BsdfSample, BsdfSampling, CosineQuery, sample_cosine_lanes};
+use super::{
+    EmissionProbe, Estimator, ProbePacket, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
+    Strategy,
+};
+use crate::bsdf::{BsdfSampling, CosineLanes, CosineQuery, sample_cosine_lanes};
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
 use crate::sampling::warp::{
@@ -12,7 +15,8 @@ use crate::sampling::warp::{
     sample_uniform_hemisphere,
 };
 use crate::sampling::{Dimension, Dims, Layout, PacketDims};
-use crate::simd::{Isa, WIDTH};
+use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, WIDTH};
+use std::f32::consts::FRAC_1_PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DirectionKind {
@@ -181,9 +185,7 @@ impl Estimator for DirectionEstimator {
                 }
             }
             DirectionKind::Bsdf => {
-                bsdf_sample_packet(self.isa, packet, u, self.strategy.sampling, |lane, s| {
-                    out.set(lane, emission_probe_lane(packet, lane, s.wi, s.f, s.pdf));
-                })
+                bsdf_emission_packet(self.isa, packet, u, self.strategy.sampling, out)
             }
         }
     }
@@ -201,38 +203,47 @@ fn cosine_query(packet: &ShadingPacket, u: [&[f32; WIDTH]; 2]) -> CosineQuery {
     }
 }
 
-/// `sp.bsdf.sample(u.get_3d(), sampling)` for each lane of a packet, bit for bit, handed to
-/// `emit(lane, sample)`: lanes whose material is cosine-sampled draw their directions
-/// over lanes ([`sample_cosine_lanes`]: the lobe drawn by u[2] does not change the direction),
-/// the others one by one. f and the mixture pdf are evaluated lane by lane.
+/// The emission probe of `sp.bsdf.sample(u.get_3d(), sampling)` for each lane of a packet,
+/// bit for bit, written into `out` (the probes of [`emission_probe_with`]): lanes whose
+/// material is cosine-sampled draw their directions over lanes ([`sample_cosine_lanes`]: the
+/// lobe drawn by u[2] does not change the direction), the others one by one. Diffuse lanes
+/// (a material of one built-in Lambert lobe) finish over lanes too, f = kd/π and pdf = cos/π
+/// with the scalar path's operations ([`DiffuseProbes`]); the other cosine-sampled ones
+/// evaluate f and the mixture pdf lane by lane.
 #[inline(always)]
-pub fn bsdf_sample_packet(
+pub fn bsdf_emission_packet(
     isa: Isa,
     packet: &ShadingPacket,
     u: &mut PacketDims,
     sampling: BsdfSampling,
-    mut emit: impl FnMut(usize, BsdfSample),
+    out: &mut ProbePacket,
 ) {
     let [u0, u1, u2] = u.take::<3>();
-    let mut mask = 0u32;
+    let (mut cosine, mut diffuse) = (0u32, 0u32);
+    let mut kd = Soa3::default();
     let mut rest = packet.mask;
     while rest != 0 {
         let lane = rest.trailing_zeros() as usize;
         rest &= rest - 1;
-        let Some(bsdf) = packet.local_bsdf(lane) else {
+        let Some(bsdf) = packet.bsdf[lane] else {
             continue;
         };
-        if bsdf.bsdf.is_cosine_sampled() {
-            mask |= 1 << lane;
-        } else {
-            emit(lane, bsdf.sample([u0[lane], u1[lane], u2[lane]], sampling));
+        if let Some(k) = bsdf.diffuse() {
+            diffuse |= 1 << lane;
+            kd.set(lane, k);
+        } else if bsdf.is_cosine_sampled() {
+            cosine |= 1 << lane;
+        } else if let Some(bsdf) = packet.local_bsdf(lane) {
+            let s = bsdf.sample([u0[lane], u1[lane], u2[lane]], sampling);
+            let e = emission_probe_lane(packet, lane, s.wi, s.f, s.pdf).emission;
+            out.set_emission(lane, e);
         }
     }
-    if mask == 0 {
+    if cosine | diffuse == 0 {
         return;
     }
     let r = sample_cosine_lanes(isa, &cosine_query(packet, [u0, u1]));
-    let mut rest = mask;
+    let mut rest = cosine;
     while rest != 0 {
         let lane = rest.trailing_zeros() as usize;
         rest &= rest - 1;
@@ -240,12 +251,71 @@ pub fn bsdf_sample_packet(
             continue;
         };
         let local = r.local.get(lane);
-        let sample = BsdfSample {
-            wi: r.wi.get(lane),
-            f: bsdf.eval_local(local),
-            pdf: bsdf.pdf_local(local, sampling),
-        };
-        emit(lane, sample);
+        let (f, pdf) = (bsdf.eval_local(local), bsdf.pdf_local(local, sampling));
+        let e = emission_probe_lane(packet, lane, r.wi.get(lane), f, pdf).emission;
+        out.set_emission(lane, e);
+    }
+    if diffuse != 0 {
+        simd::run(
+            isa,
+            DiffuseProbes {
+                r: &r,
+                kd: &kd,
+                geo: &packet.geo,
+                mask: diffuse,
+                out,
+            },
+        );
+    }
+}
+
+/// The emission probes of diffuse lanes `mask` over lanes: `Bsdf::eval` (`0 + kd/π` above the
+/// surface, else 0), `Bsdf::pdf` (`0 + max(cos θ, 0)/π`) and [`emission_probe_from`] (no probe
+/// where n·wi ≤ 0 or pdf ≤ 0, else weight f·(n·wi/pdf)), each with the scalar operations in
+/// their order, so every lane is its scalar probe bit for bit.
+struct DiffuseProbes<'a> {
+    r: &'a CosineLanes,
+    kd: &'a Soa3,
+    geo: &'a ShadingLanes,
+    mask: u32,
+    out: &'a mut ProbePacket,
+}
+
+impl simd::Kernel for DiffuseProbes<'_> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let zero = L::V::splat(0.0);
+        let inv_pi = L::V::splat(FRAC_1_PI);
+        let (wi, local) = (
+            V3::<L::V>::load(&self.r.wi),
+            V3::<L::V>::load(&self.r.local),
+        );
+        let above = !local.z.le(zero);
+        let kd = V3::<L::V>::load(self.kd).scale(inv_pi);
+        let f = V3::splat(glam::Vec3::ZERO) + V3::select(above, kd, V3::splat(glam::Vec3::ZERO));
+        let pdf = zero.add(local.z.max(zero).mul(inv_pi));
+        let cos = V3::<L::V>::load(&self.geo.n).dot(wi);
+        let ok = self.mask & !cos.le(zero) & !pdf.le(zero);
+        let weight = f.scale(cos.div(pdf));
+        let out = self.out;
+        let e = &mut out.emission;
+        let origin = V3::<L::V>::load(&self.geo.origin);
+        let rows: [(&mut [f32; WIDTH], L::V); 7] = [
+            (&mut e.ox, origin.x),
+            (&mut e.oy, origin.y),
+            (&mut e.oz, origin.z),
+            (&mut e.dx, wi.x),
+            (&mut e.dy, wi.y),
+            (&mut e.dz, wi.z),
+            (&mut e.tmax, L::V::splat(f32::INFINITY)),
+        ];
+        for (row, v) in rows {
+            L::V::select(ok, v, L::V::load(row)).store(row);
+        }
+        V3::select(ok, weight, V3::load(&out.emission_weight)).store(&mut out.emission_weight);
+        L::V::select(ok, pdf, L::V::load(&out.emission_pdf)).store(&mut out.emission_pdf);
+        out.emission_mask = (out.emission_mask & !self.mask) | ok;
     }
 }
 

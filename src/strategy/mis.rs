@@ -5,7 +5,7 @@
 //! includes the light-selection pmf (redner #56). The BSDF sample, and the BSDF pdf of light
 //! samples, follow the strategy's [`BsdfSampling`] part (lobe selection, GGX sampler).
 
-use super::direction::{BSDF_DIMS, bsdf_sample_packet, emission_probe_lane, emission_probe_with};
+use super::direction::{BSDF_DIMS, bsdf_emission_packet, emission_probe_with};
 use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
 use super::{
     EmissionProbe, Estimator, Integrand, ProbePacket, Probes, ShadingPacket, ShadingPoint,
@@ -278,16 +278,7 @@ impl Estimator for MisEstimator<'_> {
             .probe_packet_rows(packet, u, out, |bsdf, pdf, local, light| {
                 self.light_weight(bsdf, pdf, local, light)
             });
-        bsdf_sample_packet(
-            self.lights.isa,
-            packet,
-            u,
-            self.strategy.sampling,
-            |lane, bs| {
-                let e = emission_probe_lane(packet, lane, bs.wi, bs.f, bs.pdf).emission;
-                out.set_emission(lane, e);
-            },
-        );
+        bsdf_emission_packet(self.lights.isa, packet, u, self.strategy.sampling, out);
     }
 
     fn emission_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe, hit: &SurfaceHit) -> f32 {
