@@ -36,7 +36,8 @@ const SCENES: [&str; 8] = [
 ];
 
 /// A floor under a rectangle light whose edges have no zero component, so every lane
-/// operation's rounding shows (the built-in quads are axis-aligned or tilted about one axis).
+/// operation's rounding shows (the built-in quads are axis-aligned or tilted about one axis),
+/// beside a point light, so that MIS meets delta lights and area lights in one packet.
 const TILTED: &str = r#"
 [camera]
 eye = [0.3, 1.2, 4.0]
@@ -62,6 +63,9 @@ edge_u = [0.4, 0.2, 0.4]
 edge_v = [-0.3333333, 0.3333333, 0.16666667]
 material = "lamp"
 emission = [3.0, 2.0, 1.0]
+[[point_light]]
+position = [0.7, 1.1, 0.4]
+power = [4.0, 4.0, 4.0]
 "#;
 
 fn scenes() -> Vec<(String, PreparedScene)> {

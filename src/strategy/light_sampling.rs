@@ -171,9 +171,9 @@ fn shadow_values(
     packet: &ShadingPacket,
     r: &ShadowRays,
     ls: &LaneSamples,
+    mut valid: u32,
     mut each: impl FnMut(usize, &LocalBsdf, Vec3, Vec3),
 ) {
-    let mut valid = r.valid & packet.mask;
     while valid != 0 {
         let lane = valid.trailing_zeros() as usize;
         valid &= valid - 1;
@@ -183,6 +183,69 @@ fn shadow_values(
         let local = r.local.get(lane);
         let value = bsdf.eval_local(local) * ls.radiance.get(lane) * r.factor[lane];
         each(lane, &bsdf, local, value);
+    }
+}
+
+/// How a light sample's value is weighted: 1 for light sampling alone, the MIS weight for
+/// MIS. The same rule twice: lane by lane for any material, and over lanes for diffuse ones.
+pub trait LightWeight {
+    /// The weight of a light sample of light `light` with pdf `pdf` (selection included),
+    /// direction `local` in the shading frame, from a point of material `bsdf`.
+    fn lane(&self, bsdf: &LocalBsdf, pdf: f32, local: Vec3, light: usize) -> f32;
+    /// [`Self::lane`] over lanes for diffuse materials, whose BSDF pdf `p_bsdf` (the cosine
+    /// density) is given; `delta` holds the lanes whose light is a delta light. Bit for bit
+    /// `lane` in every lane it is asked for.
+    fn diffuse_lanes<V: Vector<WIDTH>>(&self, pdf: V, p_bsdf: V, delta: u32) -> V;
+    /// Whether [`Self::diffuse_lanes`] reads `delta` (else it is not worked out).
+    const READS_DELTA: bool = true;
+}
+
+/// Light sampling alone: every weight is 1.
+pub struct Unweighted;
+
+impl LightWeight for Unweighted {
+    #[inline(always)]
+    fn lane(&self, _: &LocalBsdf, _: f32, _: Vec3, _: usize) -> f32 {
+        1.0
+    }
+
+    #[inline(always)]
+    fn diffuse_lanes<V: Vector<WIDTH>>(&self, _: V, _: V, _: u32) -> V {
+        V::splat(1.0)
+    }
+
+    const READS_DELTA: bool = false;
+}
+
+/// The values of diffuse shadow lanes `mask` over lanes: `Bsdf::eval` (`0 + kd/π` above the
+/// surface, else 0) times the radiance times cos θ/pdf, then times the weight, whose BSDF pdf
+/// is `Bsdf::pdf`'s `0 + max(cos θ, 0)/π`: the scalar operations in their order, so every
+/// lane is its scalar value bit for bit.
+struct DiffuseValues<'a, W> {
+    r: &'a ShadowRays,
+    radiance: &'a Soa3,
+    kd: &'a Soa3,
+    mask: u32,
+    delta: u32,
+    weight: &'a W,
+    out: &'a mut Soa3,
+}
+
+impl<W: LightWeight> simd::Kernel for DiffuseValues<'_, W> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let zero = L::V::splat(0.0);
+        let inv_pi = L::V::splat(std::f32::consts::FRAC_1_PI);
+        let z = L::V::load(&self.r.local.z);
+        let kd = V3::<L::V>::load(self.kd).scale(inv_pi);
+        let f = V3::splat(Vec3::ZERO) + V3::select(!z.le(zero), kd, V3::splat(Vec3::ZERO));
+        let value = (f * V3::load(self.radiance)).scale(L::V::load(&self.r.factor));
+        let p_bsdf = zero.add(z.max(zero).mul(inv_pi));
+        let w = self
+            .weight
+            .diffuse_lanes::<L::V>(L::V::load(&self.r.pdf), p_bsdf, self.delta);
+        V3::select(self.mask, value.scale(w), V3::load(self.out)).store(self.out);
     }
 }
 
@@ -254,31 +317,38 @@ impl<'s> BoundLights<'s> {
     ) {
         let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
         let r = self.shadow_rays(packet, u, &mut ls, &mut light);
-        shadow_values(packet, &r, &ls, |lane, _, local, value| {
-            let mut sample = ls
-                .get(lane)
-                .expect("a valid shadow lane has a light sample");
-            sample.pdf = r.pdf[lane];
-            let ray = Ray::new(packet.geo.origin.get(lane), r.dir.get(lane), r.tmax[lane]);
-            emit(
-                lane,
-                (ShadowProbe { ray, value }, sample, local, light[lane]),
-            );
-        });
+        shadow_values(
+            packet,
+            &r,
+            &ls,
+            r.valid & packet.mask,
+            |lane, _, local, value| {
+                let mut sample = ls
+                    .get(lane)
+                    .expect("a valid shadow lane has a light sample");
+                sample.pdf = r.pdf[lane];
+                let ray = Ray::new(packet.geo.origin.get(lane), r.dir.get(lane), r.tmax[lane]);
+                emit(
+                    lane,
+                    (ShadowProbe { ray, value }, sample, local, light[lane]),
+                );
+            },
+        );
     }
 
     /// [`Self::probe_packet`]'s shadow probes written into `out`'s shadow rows (the rays as
-    /// the kernel computed them, no lane moved on its own), each value times
-    /// `weight(bsdf, pdf, local, light)` (1 for plain light sampling, the MIS weight for MIS:
-    /// `value · w`, as the scalar path's `value *= w`): the lane's material, the light
-    /// sample's pdf with the selection's, its direction in the shading frame and the light.
+    /// the kernel computed them, no lane moved on its own), each value times its
+    /// [`LightWeight`] (1 for plain light sampling, the MIS weight for MIS: `value · w`, as the
+    /// scalar path's `value *= w`). Diffuse lanes (a material of one built-in Lambert lobe)
+    /// evaluate f = kd/π, the value and the weight over lanes, with the scalar operations in
+    /// their order ([`DiffuseValues`]); the others lane by lane.
     #[inline(always)]
-    pub fn probe_packet_rows(
+    pub fn probe_packet_rows<W: LightWeight>(
         &self,
         packet: &ShadingPacket,
         u: &mut PacketDims,
         out: &mut ProbePacket,
-        mut weight: impl FnMut(&LocalBsdf, f32, Vec3, usize) -> f32,
+        weight: &W,
     ) {
         let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
         let r = self.shadow_rays(packet, u, &mut ls, &mut light);
@@ -288,10 +358,56 @@ impl<'s> BoundLights<'s> {
         (o.dx, o.dy, o.dz) = (r.dir.x, r.dir.y, r.dir.z);
         o.tmax = r.tmax;
         out.shadow_mask = valid;
-        shadow_values(packet, &r, &ls, |lane, bsdf, local, value| {
-            let w = weight(bsdf, r.pdf[lane], local, light[lane]);
-            out.shadow_value.set(lane, value * w);
-        });
+        let (mut diffuse, mut delta) = (0u32, 0u32);
+        let mut kd = Soa3::default();
+        // Whether a light is a delta light, asked once per run of lanes holding it.
+        let mut last: Option<(usize, bool)> = None;
+        let mut rest = valid;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let Some(k) = packet.bsdf[lane].and_then(|b| b.diffuse()) else {
+                continue;
+            };
+            diffuse |= 1 << lane;
+            kd.set(lane, k);
+            if !W::READS_DELTA {
+                continue;
+            }
+            let is_delta = match last {
+                Some((i, d)) if i == light[lane] => d,
+                _ => {
+                    let d = self.lights.get(light[lane]).is_delta();
+                    last = Some((light[lane], d));
+                    d
+                }
+            };
+            delta |= (is_delta as u32) << lane;
+        }
+        shadow_values(
+            packet,
+            &r,
+            &ls,
+            valid & !diffuse,
+            |lane, bsdf, local, value| {
+                let w = weight.lane(bsdf, r.pdf[lane], local, light[lane]);
+                out.shadow_value.set(lane, value * w);
+            },
+        );
+        if diffuse != 0 {
+            simd::run(
+                self.isa,
+                DiffuseValues {
+                    r: &r,
+                    radiance: &ls.radiance,
+                    kd: &kd,
+                    mask: diffuse,
+                    delta,
+                    weight,
+                    out: &mut out.shadow_value,
+                },
+            );
+        }
     }
 
     /// The shadow rays of a packet's light samples: the lights chosen lane by lane, each
@@ -537,6 +653,6 @@ impl Estimator for LightEstimator<'_> {
     }
 
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
-        self.0.probe_packet_rows(packet, u, out, |_, _, _, _| 1.0);
+        self.0.probe_packet_rows(packet, u, out, &Unweighted);
     }
 }

@@ -6,7 +6,9 @@
 //! samples, follow the strategy's [`BsdfSampling`] part (lobe selection, GGX sampler).
 
 use super::direction::{BSDF_DIMS, bsdf_emission_packet, emission_probe_with};
-use super::light_sampling::{BoundLights, LIGHT_DIMS, LightProbe, selector_applies, with_selector};
+use super::light_sampling::{
+    BoundLights, LIGHT_DIMS, LightProbe, LightWeight, selector_applies, with_selector,
+};
 use super::{
     EmissionProbe, Estimator, Integrand, ProbePacket, Probes, ShadingPacket, ShadingPoint,
     ShadowProbe, Strategy, env_method_name,
@@ -17,7 +19,7 @@ use crate::lights::selector::{SelectorType, default_selector};
 use crate::lights::{LightMethods, LightShape, SurfaceLanes};
 use crate::prepare::{SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout, PacketDims};
-use crate::simd::Soa3;
+use crate::simd::{Soa3, Vector, WIDTH};
 use crate::tracer::LANES;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -39,10 +41,17 @@ impl Heuristic {
     /// Weight of a sample drawn with pdf `a` when the other strategy has pdf `b` (a > 0).
     /// In ratio form, so huge pdfs (tiny lights) cannot overflow.
     pub fn weight(&self, a: f32, b: f32) -> f32 {
-        let r = b / a;
+        self.weight_lanes::<f32, 1>(a, b)
+    }
+
+    /// [`Self::weight`] over lanes (f32 is its one lane): the same operations.
+    #[inline(always)]
+    pub fn weight_lanes<V: Vector<N>, const N: usize>(&self, a: V, b: V) -> V {
+        let r = b.div(a);
+        let one = V::splat(1.0);
         match self {
-            Heuristic::Balance => 1.0 / (1.0 + r),
-            Heuristic::Power => 1.0 / (1.0 + r * r),
+            Heuristic::Balance => one.div(one.add(r)),
+            Heuristic::Power => one.div(one.add(r.mul(r))),
         }
     }
 }
@@ -247,10 +256,19 @@ impl MisEstimator<'_> {
     #[inline(always)]
     fn light_weight(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3, light: usize) -> f32 {
         if self.lights.lights.get(light).is_delta() {
-            return 1.0;
+            return self.delta_rule::<f32, 1>(pdf, 0.0, 1);
         }
         let p_bsdf = bsdf.pdf_local(local, self.strategy.sampling);
-        self.strategy.heuristic.weight(pdf, p_bsdf)
+        self.delta_rule::<f32, 1>(pdf, p_bsdf, 0)
+    }
+
+    /// The weight of light samples with pdf `pdf` against BSDF pdf `p_bsdf`, 1 in the lanes
+    /// of `delta` (delta lights: light sampling alone reaches them). Lane by lane (f32) and
+    /// over lanes: one rule.
+    #[inline(always)]
+    fn delta_rule<V: Vector<N>, const N: usize>(&self, pdf: V, p_bsdf: V, delta: u32) -> V {
+        let w = self.strategy.heuristic.weight_lanes::<V, N>(pdf, p_bsdf);
+        V::select(delta, V::splat(1.0), w)
     }
 
     /// The sample after its light probe: the probe's MIS weight, then the BSDF sample.
@@ -259,6 +277,18 @@ impl MisEstimator<'_> {
         let bs = sp.bsdf.sample(u.get_3d(), self.strategy.sampling);
         let emission = emission_probe_with(sp, bs.wi, bs.f, bs.pdf).emission;
         Probes { shadow, emission }
+    }
+}
+
+impl LightWeight for MisEstimator<'_> {
+    #[inline(always)]
+    fn lane(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3, light: usize) -> f32 {
+        self.light_weight(bsdf, pdf, local, light)
+    }
+
+    #[inline(always)]
+    fn diffuse_lanes<V: Vector<WIDTH>>(&self, pdf: V, p_bsdf: V, delta: u32) -> V {
+        self.delta_rule::<V, WIDTH>(pdf, p_bsdf, delta)
     }
 }
 
@@ -274,10 +304,7 @@ impl Estimator for MisEstimator<'_> {
 
     fn sample_packet(&self, packet: &ShadingPacket, u: &mut PacketDims, out: &mut ProbePacket) {
         // Each light probe weighted as its value is made.
-        self.lights
-            .probe_packet_rows(packet, u, out, |bsdf, pdf, local, light| {
-                self.light_weight(bsdf, pdf, local, light)
-            });
+        self.lights.probe_packet_rows(packet, u, out, self);
         bsdf_emission_packet(self.lights.isa, packet, u, self.strategy.sampling, out);
     }
 
