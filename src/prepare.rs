@@ -42,6 +42,49 @@ pub struct PreparedScene {
     pub world: World,
     pub lights: LightSet,
     pub tracer: Box<dyn Tracer>,
+    /// The emitting primitives alone, traced by the same backend; None where nothing emits.
+    pub emitters: Option<Emitters>,
+}
+
+/// The emitting primitives of a scene in a tracer of their own. An emission probe adds
+/// radiance only where its closest hit is an emitter, so the renderer finds the nearest
+/// emitter hit here (a tree of a few primitives) and asks the whole scene only whether
+/// something lies before it: an occlusion query, and none at all for the many probes that
+/// meet no emitter (docs/tracer.md, stop 38). Its primitives keep the scene's order, so
+/// among emitters the closest-hit rule picks what the whole scene's tracer would.
+pub struct Emitters {
+    pub tracer: Box<dyn Tracer>,
+    /// The scene's primitive id of each of this tracer's primitives (increasing).
+    pub prims: Vec<u32>,
+}
+
+impl Emitters {
+    /// Triangles, then spheres, whose primitive ids `emits`, as a geometry of their own.
+    fn build(
+        g: &Geometry,
+        emits: impl Fn(u32) -> bool,
+        make_tracer: &mut impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
+    ) -> Option<Self> {
+        let mut sub = Geometry::default();
+        let mut prims = vec![];
+        for (i, t) in g.triangles.iter().enumerate() {
+            if emits(i as u32) {
+                sub.triangles.push(*t);
+                prims.push(i as u32);
+            }
+        }
+        for (j, s) in g.spheres.iter().enumerate() {
+            let prim = (g.triangles.len() + j) as u32;
+            if emits(prim) {
+                sub.spheres.push(*s);
+                prims.push(prim);
+            }
+        }
+        (!prims.is_empty()).then(|| Emitters {
+            tracer: make_tracer(Arc::new(sub)),
+            prims,
+        })
+    }
 }
 
 /// A surface point hit by a ray.
@@ -128,7 +171,7 @@ impl PreparedScene {
     /// Prepares with a tracer of the caller's choice (a backend built over the same geometry).
     pub fn with_tracer(
         scene: Scene,
-        make_tracer: impl FnOnce(Arc<Geometry>) -> Box<dyn Tracer>,
+        mut make_tracer: impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
     ) -> Self {
         let mut g = Geometry::default();
         let mut prim_material = Vec::new();
@@ -215,6 +258,11 @@ impl PreparedScene {
         let triangle_normals = g.triangles.iter().map(|t| t.cross().normalize()).collect();
         let geometry = Arc::new(g);
         let tracer = make_tracer(geometry.clone());
+        let emitters = Emitters::build(
+            &geometry,
+            |prim| prim_emitter[prim as usize].is_some(),
+            &mut make_tracer,
+        );
         PreparedScene {
             world: World {
                 geometry,
@@ -227,8 +275,27 @@ impl PreparedScene {
             },
             lights: LightSet::new(lights, environment),
             tracer,
+            emitters,
             scene,
         }
+    }
+
+    /// Traces with the tracers `make_tracer` builds (the scene's and its emitters'), handing
+    /// back the ones it replaces.
+    pub fn replace_tracers(
+        &mut self,
+        mut make_tracer: impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
+    ) -> (Box<dyn Tracer>, Option<Emitters>) {
+        let tracer = make_tracer(self.world.geometry.clone());
+        let emitters = Emitters::build(
+            &self.world.geometry,
+            |prim| self.world.prim_emitter[prim as usize].is_some(),
+            &mut make_tracer,
+        );
+        (
+            std::mem::replace(&mut self.tracer, tracer),
+            std::mem::replace(&mut self.emitters, emitters),
+        )
     }
 
     /// The scene as `integrand` sees it.

@@ -369,10 +369,19 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
     if let Some(strategy) = applicable.first() {
         let reference = render(scene, strategy.as_ref(), seed, RENDER_PASSES)?;
         for name in names.iter().skip(1) {
-            let tracer = backends::build(name, scene.world.geometry.clone())?;
-            let original = std::mem::replace(&mut scene.tracer, tracer);
-            let img = render(scene, strategy.as_ref(), seed, RENDER_PASSES)?;
-            scene.tracer = original;
+            let mut err = None;
+            let (tracer, emitters) = scene.replace_tracers(|g| {
+                backends::build(name, g.clone()).unwrap_or_else(|e| {
+                    err = Some(e);
+                    backends::build("obvhs", g).expect("the obvhs backend always builds")
+                })
+            });
+            let img = match err {
+                Some(e) => Err(e),
+                None => render(scene, strategy.as_ref(), seed, RENDER_PASSES),
+            };
+            (scene.tracer, scene.emitters) = (tracer, emitters);
+            let img = img?;
             let d = image_rel_rmse(&reference, &img);
             let pass = d <= MAX_IMAGE_REL_RMSE;
             if !pass {
