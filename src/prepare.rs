@@ -47,15 +47,12 @@ pub struct PreparedScene {
 }
 
 /// The emitting primitives of a scene in a tracer of their own. An emission probe adds
-/// radiance only where its closest hit is an emitter, so the renderer finds the nearest
-/// emitter hit here (a tree of a few primitives) and asks the whole scene only whether
-/// something lies before it: an occlusion query, and none at all for the many probes that
-/// meet no emitter (docs/tracer.md, stop 38). Its primitives keep the scene's order, so
-/// among emitters the closest-hit rule picks what the whole scene's tracer would.
+/// radiance only where its closest hit is an emitter, and a ray whose closest hit is an
+/// emitter meets one: the renderer asks this tracer (a tree of a few primitives) which rays
+/// meet an emitter at all, and the whole scene for the closest hits of those alone
+/// (docs/tracer.md, stop 38).
 pub struct Emitters {
     pub tracer: Box<dyn Tracer>,
-    /// The scene's primitive id of each of this tracer's primitives (increasing).
-    pub prims: Vec<u32>,
 }
 
 impl Emitters {
@@ -66,23 +63,18 @@ impl Emitters {
         make_tracer: &mut impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
     ) -> Option<Self> {
         let mut sub = Geometry::default();
-        let mut prims = vec![];
         for (i, t) in g.triangles.iter().enumerate() {
             if emits(i as u32) {
                 sub.triangles.push(*t);
-                prims.push(i as u32);
             }
         }
         for (j, s) in g.spheres.iter().enumerate() {
-            let prim = (g.triangles.len() + j) as u32;
-            if emits(prim) {
+            if emits((g.triangles.len() + j) as u32) {
                 sub.spheres.push(*s);
-                prims.push(prim);
             }
         }
-        (!prims.is_empty()).then(|| Emitters {
+        (sub.prim_count() > 0).then(|| Emitters {
             tracer: make_tracer(Arc::new(sub)),
-            prims,
         })
     }
 }

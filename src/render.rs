@@ -20,7 +20,7 @@ use crate::strategy::{
     EmissionProbe, Estimator, PassPoints, ProbePacket, ShadingLanes, ShadingPacket, ShadingPoint,
     Strategy,
 };
-use crate::tracer::{HitPacket, LANES, LaneMask, NO_HIT, RayPacket};
+use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -354,36 +354,45 @@ impl<'a> Renderer<'a> {
     }
 
     /// What the emission rays `mask` of `emit` see that can add radiance: the lanes whose
-    /// closest hit is an emitter (`found`, their hits in `hits`, the scene's primitive ids)
-    /// and, where the scene has an environment, the lanes that hit nothing (`escaped`). The
-    /// nearest emitter hit comes from the emitters' own tracer; the whole scene is asked only
-    /// whether anything lies before it (or, for the environment, anywhere on the ray). Other
-    /// lanes see a non-emitting surface, which adds nothing. The same answer as the scene's
-    /// closest hit, except where a surface lies at exactly the emitter's distance, which the
-    /// closest-hit rule resolves by primitive id and this resolves for the emitter.
+    /// closest hit is an emitter (`found`, their hits in `hits`) and, where the scene has an
+    /// environment, the lanes that hit nothing (`escaped`); `hits` holds no hit in every other
+    /// lane. A ray whose closest hit is an emitter meets an emitter, so the emitters' own
+    /// tracer first tells which rays meet one at all (an occlusion query of a tree of a few
+    /// primitives); only those ask the scene for their closest hit. The others can only
+    /// escape: with an environment the scene is asked whether anything lies on them (an
+    /// occlusion query, which stops at its first hit), and without one they are done. The
+    /// same answers as a closest-hit query of every lane, ties included, with any backend:
+    /// every decision about an emitter is the scene's own closest hit.
     fn trace_emission(&self, emit: &RayPacket, mask: LaneMask, hits: &mut HitPacket) -> (u32, u32) {
         let scene = self.scene;
         let env = scene.lights.environment().is_some();
-        *hits = HitPacket::default();
-        let mut hit = 0u32;
-        let mut rays = *emit;
-        if let Some(e) = &scene.emitters {
-            e.tracer.intersect_packet(emit, mask, hits);
-            for lane in 0..LANES {
-                if mask >> lane & 1 != 0 && hits.prim[lane] != NO_HIT {
-                    hits.prim[lane] = e.prims[hits.prim[lane] as usize];
-                    rays.tmax[lane] = hits.t[lane];
-                    hit |= 1 << lane;
+        let near = match &scene.emitters {
+            Some(e) => e.tracer.occluded_packet(emit, mask) as u32,
+            None => 0,
+        };
+        let (mut found, mut escaped) = (0u32, 0u32);
+        if near != 0 {
+            scene.tracer.intersect_packet(emit, near as LaneMask, hits);
+        }
+        for lane in 0..LANES {
+            if near >> lane & 1 == 0 {
+                hits.set(lane, None);
+                continue;
+            }
+            match hits.get(lane) {
+                Some(h) if scene.world.prim_emitter[h.prim as usize].is_some() => {
+                    found |= 1 << lane
                 }
+                None if env => escaped |= 1 << lane,
+                _ => {}
             }
         }
-        let asked = if env { mask as u32 } else { hit };
-        if asked == 0 {
-            return (0, 0);
+        let rest = if env { mask as u32 & !near } else { 0 };
+        if rest != 0 {
+            let blocked = scene.tracer.occluded_packet(emit, rest as LaneMask) as u32;
+            escaped |= rest & !blocked;
         }
-        let blocked = scene.tracer.occluded_packet(&rays, asked as LaneMask) as u32;
-        let escaped = if env { asked & !hit & !blocked } else { 0 };
-        (hit & !blocked, escaped)
+        (found, escaped)
     }
 
     /// The estimator's probes for the tile's points, traced as packets.
@@ -705,10 +714,10 @@ mod tests {
         }
     }
 
-    /// The emission rays' answer from the emitters' own tracer and one occlusion query is the
-    /// scene's closest hit, bit for bit: a lane is `found` exactly where its closest hit is an
-    /// emitter, with that hit (the scene's primitive id), and `escaped` exactly where it hits
-    /// nothing and the scene has an environment. Camera rays (which see lights directly) and
+    /// The emission rays' answer, with the emitters' own tracer in front, is the scene's
+    /// closest hit, bit for bit: a lane is `found` exactly where its closest hit is an
+    /// emitter, with that hit, and `escaped` exactly where it hits nothing and the scene has
+    /// an environment. Camera rays (which see lights directly) and
     /// rays from surface points in random directions, with emitting quads, a sphere, a mesh
     /// and an environment beside an emitter.
     #[test]
@@ -730,12 +739,13 @@ mod tests {
             let env = scene.lights.environment().is_some();
             let strategy = crate::strategy::reference_strategy(scene, Integrand::DIRECT).unwrap();
             let r = Renderer::new(scene, strategy.as_ref(), 3).unwrap();
+            // One scratch for every packet, as a worker reuses it.
+            let mut hits = HitPacket::default();
             for set in crate::harness::raysets::generate(scene, 48, 48, 5) {
                 if !matches!(set.class, "primary" | "incoherent") {
                     continue;
                 }
                 for (p, &m) in set.packets.iter().zip(&set.masks) {
-                    let mut hits = HitPacket::default();
                     let (found, escaped) = r.trace_emission(p, m, &mut hits);
                     for lane in 0..LANES {
                         if m >> lane & 1 == 0 {
@@ -750,7 +760,7 @@ mod tests {
                             env && closest.is_none(),
                             "{name} lane {lane}"
                         );
-                        if emits {
+                        if emits || escaped >> lane & 1 != 0 {
                             assert_eq!(hits.get(lane), closest, "{name} lane {lane}");
                         }
                     }
