@@ -5,6 +5,7 @@ use super::material::{MaterialType, Params};
 use super::{Bsdf, Lobe, MicrofacetSampler};
 use crate::error::Result;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::simd::{V3, Vector, WIDTH};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 
@@ -36,6 +37,17 @@ impl Lobe for Lambert {
     fn is_cosine_sampled(&self) -> bool {
         true
     }
+}
+
+/// `Bsdf::eval` and `Bsdf::pdf` of a diffuse material (its one Lambert lobe of `kd`) over
+/// lanes, for directions of local z `z`: `0 + kd/π` above the surface, else 0, and
+/// `0 + max(z, 0)/π`, the scalar path's operations in their order, so the same bits.
+#[inline(always)]
+pub fn diffuse_lanes<V: Vector<WIDTH>>(kd: V3<V>, z: V) -> (V3<V>, V) {
+    let (zero, inv_pi) = (V::splat(0.0), V::splat(FRAC_1_PI));
+    let none = V3::splat(Vec3::ZERO);
+    let f = none + V3::select(!z.le(zero), kd.scale(inv_pi), none);
+    (f, zero.add(z.max(zero).mul(inv_pi)))
 }
 
 /// `type = "diffuse"`: `albedo` (kd per channel in [0, 1], default black).

@@ -7,6 +7,7 @@ use super::{
     EmissionProbe, Estimator, ProbePacket, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
     Strategy,
 };
+use crate::bsdf::lambert::diffuse_lanes;
 use crate::bsdf::{BsdfSampling, CosineLanes, CosineQuery, sample_cosine_lanes};
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
@@ -16,7 +17,6 @@ use crate::sampling::warp::{
 };
 use crate::sampling::{Dimension, Dims, Layout, PacketDims};
 use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, WIDTH};
-use std::f32::consts::FRAC_1_PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum DirectionKind {
@@ -269,10 +269,10 @@ pub fn bsdf_emission_packet(
     }
 }
 
-/// The emission probes of diffuse lanes `mask` over lanes: `Bsdf::eval` (`0 + kd/π` above the
-/// surface, else 0), `Bsdf::pdf` (`0 + max(cos θ, 0)/π`) and [`emission_probe_from`] (no probe
-/// where n·wi ≤ 0 or pdf ≤ 0, else weight f·(n·wi/pdf)), each with the scalar operations in
-/// their order, so every lane is its scalar probe bit for bit.
+/// The emission probes of diffuse lanes `mask` over lanes: f and the pdf by
+/// [`diffuse_lanes`], then [`emission_probe_from`] (no probe where n·wi ≤ 0 or pdf ≤ 0, else
+/// weight f·(n·wi/pdf)), each with the scalar operations in their order, so every lane is its
+/// scalar probe bit for bit.
 struct DiffuseProbes<'a> {
     r: &'a CosineLanes,
     kd: &'a Soa3,
@@ -286,15 +286,11 @@ impl simd::Kernel for DiffuseProbes<'_> {
     #[inline(always)]
     fn run<L: Lanes>(self) {
         let zero = L::V::splat(0.0);
-        let inv_pi = L::V::splat(FRAC_1_PI);
         let (wi, local) = (
             V3::<L::V>::load(&self.r.wi),
             V3::<L::V>::load(&self.r.local),
         );
-        let above = !local.z.le(zero);
-        let kd = V3::<L::V>::load(self.kd).scale(inv_pi);
-        let f = V3::splat(glam::Vec3::ZERO) + V3::select(above, kd, V3::splat(glam::Vec3::ZERO));
-        let pdf = zero.add(local.z.max(zero).mul(inv_pi));
+        let (f, pdf) = diffuse_lanes(V3::load(self.kd), local.z);
         let cos = V3::<L::V>::load(&self.geo.n).dot(wi);
         let ok = self.mask & !cos.le(zero) & !pdf.le(zero);
         let weight = f.scale(cos.div(pdf));

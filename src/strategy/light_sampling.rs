@@ -8,6 +8,7 @@ use super::{
     ShadowProbe, Strategy, env_method_name,
 };
 use crate::bsdf::LocalBsdf;
+use crate::bsdf::lambert::diffuse_lanes;
 use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
@@ -217,10 +218,9 @@ impl LightWeight for Unweighted {
     const READS_DELTA: bool = false;
 }
 
-/// The values of diffuse shadow lanes `mask` over lanes: `Bsdf::eval` (`0 + kd/π` above the
-/// surface, else 0) times the radiance times cos θ/pdf, then times the weight, whose BSDF pdf
-/// is `Bsdf::pdf`'s `0 + max(cos θ, 0)/π`: the scalar operations in their order, so every
-/// lane is its scalar value bit for bit.
+/// The values of diffuse shadow lanes `mask` over lanes: f by [`diffuse_lanes`] times the
+/// radiance times cos θ/pdf, then times the weight against [`diffuse_lanes`]' BSDF pdf: the
+/// scalar operations in their order, so every lane is its scalar value bit for bit.
 struct DiffuseValues<'a, W> {
     r: &'a ShadowRays,
     radiance: &'a Soa3,
@@ -235,13 +235,8 @@ impl<W: LightWeight> simd::Kernel for DiffuseValues<'_, W> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
-        let zero = L::V::splat(0.0);
-        let inv_pi = L::V::splat(std::f32::consts::FRAC_1_PI);
-        let z = L::V::load(&self.r.local.z);
-        let kd = V3::<L::V>::load(self.kd).scale(inv_pi);
-        let f = V3::splat(Vec3::ZERO) + V3::select(!z.le(zero), kd, V3::splat(Vec3::ZERO));
+        let (f, p_bsdf) = diffuse_lanes(V3::<L::V>::load(self.kd), L::V::load(&self.r.local.z));
         let value = (f * V3::load(self.radiance)).scale(L::V::load(&self.r.factor));
-        let p_bsdf = zero.add(z.max(zero).mul(inv_pi));
         let w = self
             .weight
             .diffuse_lanes::<L::V>(L::V::load(&self.r.pdf), p_bsdf, self.delta);
