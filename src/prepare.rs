@@ -56,20 +56,22 @@ pub struct Emitters {
 }
 
 impl Emitters {
-    /// Triangles, then spheres, whose primitive ids `emits`, as a geometry of their own.
+    /// The triangles, then spheres, of `g` that emit (`prim_emitter`, by primitive id), as a
+    /// geometry of their own; None when none does.
     fn build(
         g: &Geometry,
-        emits: impl Fn(u32) -> bool,
+        prim_emitter: &[Option<EmitterRef>],
         make_tracer: &mut impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
     ) -> Option<Self> {
+        let emits = |prim: usize| prim_emitter[prim].is_some();
         let mut sub = Geometry::default();
         for (i, t) in g.triangles.iter().enumerate() {
-            if emits(i as u32) {
+            if emits(i) {
                 sub.triangles.push(*t);
             }
         }
         for (j, s) in g.spheres.iter().enumerate() {
-            if emits((g.triangles.len() + j) as u32) {
+            if emits(g.triangles.len() + j) {
                 sub.spheres.push(*s);
             }
         }
@@ -250,11 +252,7 @@ impl PreparedScene {
         let triangle_normals = g.triangles.iter().map(|t| t.cross().normalize()).collect();
         let geometry = Arc::new(g);
         let tracer = make_tracer(geometry.clone());
-        let emitters = Emitters::build(
-            &geometry,
-            |prim| prim_emitter[prim as usize].is_some(),
-            &mut make_tracer,
-        );
+        let emitters = Emitters::build(&geometry, &prim_emitter, &mut make_tracer);
         PreparedScene {
             world: World {
                 geometry,
@@ -279,11 +277,8 @@ impl PreparedScene {
         mut make_tracer: impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
     ) -> (Box<dyn Tracer>, Option<Emitters>) {
         let tracer = make_tracer(self.world.geometry.clone());
-        let emitters = Emitters::build(
-            &self.world.geometry,
-            |prim| self.world.prim_emitter[prim as usize].is_some(),
-            &mut make_tracer,
-        );
+        let w = &self.world;
+        let emitters = Emitters::build(&w.geometry, &w.prim_emitter, &mut make_tracer);
         (
             std::mem::replace(&mut self.tracer, tracer),
             std::mem::replace(&mut self.emitters, emitters),

@@ -115,6 +115,29 @@ fn check_mean(
     }
 }
 
+/// A 0.5 × 0.6 rectangle light of radiance [`RADIANCE`] facing down, 2 above the point.
+fn rectangle() -> String {
+    format!(
+        "[[quad]]\ncorner = [-1.0, 2.0, -0.5]\nedge_u = [0.5, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.6]\nmaterial = \"m\"\nemission = {}\n",
+        rgb(RADIANCE)
+    )
+}
+
+/// The irradiance per unit radiance at the origin (normal +y) from [`rectangle`].
+fn rectangle_irradiance() -> f64 {
+    polygon_irradiance(
+        DVec3::ZERO,
+        DVec3::Y,
+        &[
+            DVec3::new(-1.0, 2.0, -0.5),
+            DVec3::new(-1.0, 2.0, 0.1),
+            DVec3::new(-0.5, 2.0, 0.1),
+            DVec3::new(-0.5, 2.0, -0.5),
+        ],
+        1.0,
+    )
+}
+
 fn rgb(c: [f32; 3]) -> String {
     format!("[{}, {}, {}]", c[0], c[1], c[2])
 }
@@ -249,23 +272,13 @@ fn mesh_light_sum_of_triangles() {
 #[test]
 fn mixed_lights_sum() {
     let body = format!(
-        "[[sphere]]\ncenter = [0.8, 1.5, 0.0]\nradius = 0.3\nmaterial = \"m\"\nemission = {l}\n\
-         [[quad]]\ncorner = [-1.0, 2.0, -0.5]\nedge_u = [0.5, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.6]\nmaterial = \"m\"\nemission = {l}\n",
+        "[[sphere]]\ncenter = [0.8, 1.5, 0.0]\nradius = 0.3\nmaterial = \"m\"\nemission = {l}\n{}",
+        rectangle(),
         l = rgb(RADIANCE)
     );
     let scene = prepare(&body, &[]);
     let e = sphere_irradiance(DVec3::ZERO, DVec3::Y, DVec3::new(0.8, 1.5, 0.0), 0.3, 1.0)
-        + polygon_irradiance(
-            DVec3::ZERO,
-            DVec3::Y,
-            &[
-                DVec3::new(-1.0, 2.0, -0.5),
-                DVec3::new(-1.0, 2.0, 0.1),
-                DVec3::new(-0.5, 2.0, 0.1),
-                DVec3::new(-0.5, 2.0, -0.5),
-            ],
-            1.0,
-        );
+        + rectangle_irradiance();
     check_all(&scene, DVec3::ZERO, DVec3::Y, e, 51);
 }
 
@@ -378,24 +391,13 @@ fn point_light_beside_an_area_light_sums() {
     let k = 0.4;
     let power = RADIANCE.map(|l| (4.0 * PI * k) as f32 * l);
     let body = format!(
-        "[[point_light]]\nposition = [0.3, 1.7, -0.4]\npower = {}\n\
-         [[quad]]\ncorner = [-1.0, 2.0, -0.5]\nedge_u = [0.5, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.6]\nmaterial = \"m\"\nemission = {}\n",
+        "[[point_light]]\nposition = [0.3, 1.7, -0.4]\npower = {}\n{}",
         rgb(power),
-        rgb(RADIANCE)
+        rectangle()
     );
     let scene = prepare(&body, &[]);
     let e = point_irradiance(DVec3::ZERO, DVec3::Y, DVec3::new(0.3, 1.7, -0.4), k)
-        + polygon_irradiance(
-            DVec3::ZERO,
-            DVec3::Y,
-            &[
-                DVec3::new(-1.0, 2.0, -0.5),
-                DVec3::new(-1.0, 2.0, 0.1),
-                DVec3::new(-0.5, 2.0, 0.1),
-                DVec3::new(-0.5, 2.0, -0.5),
-            ],
-            1.0,
-        );
+        + rectangle_irradiance();
     assert!(
         applies(by_name("mis-power").unwrap().as_ref(), &scene).is_ok(),
         "MIS applies beside an emitting surface"
