@@ -142,6 +142,15 @@ fn the_checkers_catch_mixed_sets_and_lost_rows() {
         check_run_dir(&run, true).is_err(),
         "a complete run without summary passed"
     );
+    // Nor one still running whose completed strategies are not summarised.
+    let meta = std::fs::read_to_string(run.join("run.json")).unwrap();
+    let mut running: serde_json::Value = serde_json::from_str(&meta).unwrap();
+    running["status"] = "running".into();
+    std::fs::write(run.join("run.json"), running.to_string()).unwrap();
+    assert!(
+        check_run_dir(&run, false).is_err(),
+        "a running run without summary passed"
+    );
 }
 
 /// `kill -9` of `reference` and `compare` at 24 random moments (fixed seed), then: every stored

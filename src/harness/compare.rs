@@ -562,8 +562,9 @@ pub fn create_run_dir(out: &Path, scene: &str, seed: u64) -> Result<RunDir> {
 
 /// Runs `strategies` at equal time, `opts.runs` times each, and writes into `run_dir`: per
 /// strategy the run-0 image and its per-pixel variance of the mean (`<strategy>.exr`,
-/// `<strategy>.variance.exr`), `results.csv` (rewritten after each strategy, so an interrupted
-/// run keeps what finished), `summary.csv` and `run.json` (which says how complete the run is).
+/// `<strategy>.variance.exr`), `results.csv` and `summary.csv` (both rewritten after each
+/// strategy, so an interrupted or killed run keeps what finished) and `run.json` (which says how
+/// complete the run is).
 pub fn run(
     scene: &PreparedScene,
     strategies: &[Box<dyn Strategy>],
@@ -631,9 +632,22 @@ pub fn run(
         .iter()
         .flat_map(|s| generators.iter().map(move |g| (s, *g)))
         .collect();
+    // Ctrl-C anywhere in the loop (between strategies, or while one's images are written) is
+    // a request: the loop stops before the next strategy with what finished in place.
+    let _polling = crate::interrupt::polling();
+    let interrupted = |meta: &RunMeta, stem: &str, run: u32| {
+        Error::Interrupted(format!(
+            "compare kept {} finished strategy run(s) in {}; `{stem}` (run {run}) was discarded",
+            meta.completed.len(),
+            dir.display(),
+        ))
+    };
     for run in 0..opts.runs {
         for &(s, g) in &pairs {
             let stem = image_stem(&s.name(), g.name());
+            if crate::interrupt::requested() {
+                return Err(interrupted(&meta, &stem, run));
+            }
             let bar = progress_bar(
                 bar_len,
                 format!("run {run} {:<10}", stem),
@@ -662,16 +676,9 @@ pub fn run(
             )?;
             bar.finish_and_clear();
             if r.interrupted {
-                // Keep what finished (results.csv is already written), summarise it, record
-                // the interruption; the unfinished strategy leaves no file behind.
-                if !finals.is_empty() {
-                    write_csv(&dir.join("summary.csv"), &summarize(&finals, opts.budget))?;
-                }
-                return Err(Error::Interrupted(format!(
-                    "compare kept {} finished strategy run(s) in {}; `{stem}` (run {run}) was discarded",
-                    meta.completed.len(),
-                    dir.display(),
-                )));
+                // What finished is already written (results.csv, summary.csv, images); the
+                // unfinished strategy leaves no file behind.
+                return Err(interrupted(&meta, &stem, run));
             }
             if run == 0 {
                 let last = r.rows.last();
@@ -718,6 +725,9 @@ pub fn run(
             finals.push(last);
             rows.extend(r.rows);
             write_csv(&dir.join("results.csv"), &rows)?;
+            // Rewritten with results.csv, so a run killed at any instant keeps a summary of
+            // what finished.
+            write_csv(&dir.join("summary.csv"), &summarize(&finals, opts.budget))?;
             run_dir.keep();
             meta.completed.push((s.name().to_string(), run));
             meta.completed_samplers.push(g.name().to_string());

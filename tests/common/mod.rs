@@ -335,6 +335,33 @@ pub fn check_run_dir(dir: &Path, settled: bool) -> Result<serde_json::Value, Str
             }
         }
     }
+    // summary.csv is rewritten with results.csv: whatever the status, it names every
+    // (strategy, sampler) that run.json calls completed.
+    if !completed.is_empty() {
+        let mut reader = csv::Reader::from_path(dir.join("summary.csv"))
+            .map_err(|e| format!("{shown}/summary.csv: {e}"))?;
+        let header = reader
+            .headers()
+            .map_err(|e| format!("{shown}/summary.csv: {e}"))?
+            .clone();
+        let column = |name: &str| header.iter().position(|h| h == name);
+        let (Some(strategy), sampler) = (column("strategy"), column("sampler")) else {
+            return Err(format!("{shown}/summary.csv: no strategy column"));
+        };
+        let mut summarised = Vec::new();
+        for r in reader.records() {
+            let r = r.map_err(|e| format!("{shown}/summary.csv: {e}"))?;
+            let g = sampler.map_or("independent", |k| &r[k]);
+            summarised.push((r[strategy].to_string(), g.to_string()));
+        }
+        for ((s, run), g) in completed.iter().zip(&samplers) {
+            if !summarised.contains(&(s.clone(), g.clone())) {
+                return Err(format!(
+                    "{shown}/summary.csv: `{s}` ({g}) run {run} is completed but not summarised"
+                ));
+            }
+        }
+    }
     if status == "complete" {
         let samplers = meta["samplers"].as_array().map_or(1, |a| a.len()) as u64;
         let strategies = meta["strategies"].as_array().map_or(0, |a| a.len()) as u64 * samplers;
