@@ -132,6 +132,8 @@ fn build_sweep() {
     let presets = [
         ("fast", P::fast_build()),
         ("medium", P::medium_build()),
+        // Medium with reinsertion over every node: today's default.
+        ("default", BuildParams::default().preset),
         ("very_slow", P::very_slow_build()),
     ];
     let isa = Isa::available()[0];

@@ -61,6 +61,7 @@ fn rays_writes_csv() {
         "mrays_per_s",
         "active_lane_fraction",
         "nodes_per_ray",
+        "build_s",
     ] {
         assert!(header.split(',').any(|c| c == col), "{header}");
     }

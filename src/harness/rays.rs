@@ -51,6 +51,18 @@ impl Subject {
         }
     }
 
+    /// How long its tree took to build: obvhs's binary tree; our wide tree (the binary build
+    /// and its collapse); Embree's scene, whose builder runs on Embree's own threads.
+    pub fn build_seconds(&self) -> f64 {
+        match self {
+            Subject::Obvhs(t) => t.build_time(),
+            Subject::Packet(t) | Subject::Single(t) => t.wide().build_time,
+            #[cfg(feature = "embree")]
+            Subject::Embree { tracer, .. } => tracer.build_time(),
+        }
+        .as_secs_f64()
+    }
+
     fn tracer(&self) -> &dyn Tracer {
         match self {
             Subject::Obvhs(t) => t,
@@ -222,6 +234,18 @@ impl std::fmt::Display for RaysReport {
                 opt(r.tests_per_ray, 1)
             )?;
         }
+        // Each subject's build, once (its rows of every class carry it).
+        let mut builds: Vec<String> = vec![];
+        for r in rows {
+            let b = format!("{} {} {:.1} ms", r.backend, r.isa, r.build_s * 1e3);
+            if !builds
+                .iter()
+                .any(|x| x.starts_with(&format!("{} {} ", r.backend, r.isa)))
+            {
+                builds.push(b);
+            }
+        }
+        writeln!(f, "build: {}", builds.join(" · "))?;
         for class in rows
             .iter()
             .map(|r| r.ray_class.clone())
@@ -266,6 +290,8 @@ pub struct RaysRow {
     /// Leaf tests (a block of up to 8 triangles, or a sphere) per ray, by packets or single
     /// rays.
     pub leaves_per_ray: Option<f64>,
+    /// How long the subject's tree took to build ([`Subject::build_seconds`]).
+    pub build_s: f64,
 }
 
 /// Times every subject on every set: `rounds` rounds, the subject order reversed on odd
@@ -324,6 +350,7 @@ pub fn measure(
                     s.single_nodes as f64 / (s.packet_nodes + s.single_nodes).max(1) as f64
                 }),
                 leaves_per_ray: st.map(|s| per_ray(s.leaves)),
+                build_s: subj.build_seconds(),
             });
         }
     }

@@ -16,6 +16,7 @@ pub struct ObvhsTracer {
     bvh: Bvh2,
     /// obvhs leaf slot → our primitive id.
     slot_prim: Vec<u32>,
+    build_time: std::time::Duration,
 }
 
 #[derive(Clone, Copy)]
@@ -56,13 +57,20 @@ pub fn build_bvh2(geometry: &Geometry, preset: BvhBuildParams) -> Bvh2 {
 
 impl ObvhsTracer {
     pub fn build(geometry: Arc<Geometry>) -> Self {
+        let start = std::time::Instant::now();
         let bvh = build_bvh2(&geometry, BvhBuildParams::medium_build());
         let slot_prim = bvh.primitive_indices.clone();
         ObvhsTracer {
             geometry,
             bvh,
             slot_prim,
+            build_time: start.elapsed(),
         }
+    }
+
+    /// How long [`Self::build`] took.
+    pub fn build_time(&self) -> std::time::Duration {
+        self.build_time
     }
 
     pub fn geometry(&self) -> &Geometry {

@@ -32,6 +32,9 @@ pub struct EmbreeTracer {
     scene: ffi::RTCScene,
     tri_geom: u32,
     sphere_geom: u32,
+    /// How long building the scene took (set-up and commit; Embree's builder uses its own
+    /// threads).
+    build_time: std::time::Duration,
     /// Receives messages from Embree's error callback; boxed so its address is stable.
     _errors: Box<Mutex<Vec<String>>>,
 }
@@ -200,6 +203,7 @@ fn valid16(active: LaneMask) -> ffi::Valid16 {
 
 impl EmbreeTracer {
     pub fn build(geometry: Arc<Geometry>) -> Result<Self> {
+        let start = std::time::Instant::now();
         let errors: Box<Mutex<Vec<String>>> = Box::default();
         // SAFETY: plain FFI calls on handles we created; every handle is checked for null and
         // the device's error state is checked after the build.
@@ -227,6 +231,7 @@ impl EmbreeTracer {
                 scene,
                 tri_geom: ffi::RTC_INVALID_GEOMETRY_ID,
                 sphere_geom: ffi::RTC_INVALID_GEOMETRY_ID,
+                build_time: std::time::Duration::ZERO,
                 _errors: errors,
             };
             if scene.is_null() {
@@ -242,8 +247,14 @@ impl EmbreeTracer {
             }
             ffi::rtcCommitScene(scene);
             tracer.check("committing the scene")?;
+            tracer.build_time = start.elapsed();
             Ok(tracer)
         }
+    }
+
+    /// How long [`Self::build`] took.
+    pub fn build_time(&self) -> std::time::Duration {
+        self.build_time
     }
 
     fn error(&self, what: &str) -> Error {
