@@ -24,6 +24,15 @@ pub struct TexelMap {
     pub texels: Vec<Vec3>,
 }
 
+/// u·side clamped to [0, side − 1] (a function, not a closure: a closure is not always inlined
+/// into the ISA's entry).
+#[inline(always)]
+fn texel_coordinate<V: Vector<N>, const N: usize>(u: V, side: usize) -> V {
+    u.mul(V::splat(side as f32))
+        .max(V::splat(0.0))
+        .min(V::splat((side - 1) as f32))
+}
+
 impl TexelMap {
     /// Each texel is the solid-angle-weighted mean of `radiance` over it (a J-weighted
     /// 4×4 midpoint rule), so the map's integral over the sphere matches the source's.
@@ -65,13 +74,17 @@ impl TexelMap {
     /// [`Self::index`] of N lanes.
     #[inline(always)]
     pub fn index_lanes<V: Vector<N>, const N: usize>(&self, u: V, v: V) -> [usize; N] {
-        let (mut x, mut y) = ([0.0f32; N], [0.0f32; N]);
-        u.mul(V::splat(self.width as f32)).store(&mut x);
-        v.mul(V::splat(self.height as f32)).store(&mut y);
+        // `(u·width as usize).min(width − 1)` and the same for v, over lanes: clamped in f32
+        // to [0, side − 1], then truncated. The same integers for every input: the sides are
+        // below 2²⁴ (so side − 1 is an f32), MAXPS takes NaN and −0 to 0 as `as` does, and a
+        // value truncates to at most side − 1 exactly when it is clamped to it.
+        debug_assert!(self.width < 1 << 24 && self.height < 1 << 24);
+        let (mut x, mut y) = ([0u32; N], [0u32; N]);
+        texel_coordinate(u, self.width).trunc_u32(&mut x);
+        texel_coordinate(v, self.height).trunc_u32(&mut y);
         let mut k = [0usize; N];
         for i in 0..N {
-            k[i] = (y[i] as usize).min(self.height - 1) * self.width
-                + (x[i] as usize).min(self.width - 1);
+            k[i] = y[i] as usize * self.width + x[i] as usize;
         }
         k
     }
@@ -331,6 +344,58 @@ impl ImportanceMap {
 mod tests {
     use super::*;
     use crate::sampling::stream::SampleStream;
+
+    /// The texel index over lanes is `(u·side as usize).min(side − 1)` per axis, for every
+    /// input a warp or a direction could give and the ones it should not (NaN, −0, below 0,
+    /// 1 and past it, huge), on every ISA. Control: the lower clamp dropped (a negative
+    /// coordinate then wraps around as an integer).
+    #[test]
+    fn texel_index_over_lanes_is_the_scalar_formula() {
+        let m = TexelMap::resample(Repr::LatLong, 8, &|_| Vec3::ZERO);
+        let odd = [
+            f32::NAN,
+            -0.0,
+            0.0,
+            -1.5,
+            -1e30,
+            f32::MIN_POSITIVE,
+            0.5,
+            1.0 - f32::EPSILON / 2.0,
+            1.0,
+            1.0 + f32::EPSILON,
+            7.9,
+            1e30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            0.0625,
+            0.999,
+        ];
+        let want = |u: f32, v: f32| {
+            let x = ((u * m.width as f32) as usize).min(m.width - 1);
+            let y = ((v * m.height as f32) as usize).min(m.height - 1);
+            y * m.width + x
+        };
+        for isa in Isa::available() {
+            for shift in 0..WIDTH {
+                let u: [f32; WIDTH] = std::array::from_fn(|i| odd[i]);
+                let v: [f32; WIDTH] = std::array::from_fn(|i| odd[(i + shift) % WIDTH]);
+                struct Index<'a>(&'a TexelMap, [f32; WIDTH], [f32; WIDTH]);
+                impl Kernel for Index<'_> {
+                    type Out = [usize; WIDTH];
+                    #[inline(always)]
+                    fn run<L: Lanes>(self) -> [usize; WIDTH] {
+                        self.0
+                            .index_lanes::<L::V, WIDTH>(L::V::load(&self.1), L::V::load(&self.2))
+                    }
+                }
+                let got = simd::run(isa, Index(&m, u, v));
+                for i in 0..WIDTH {
+                    assert_eq!(got[i], want(u[i], v[i]), "{isa:?} u {} v {}", u[i], v[i]);
+                    assert_eq!(m.index([u[i], v[i]]), want(u[i], v[i]));
+                }
+            }
+        }
+    }
 
     /// Radiance that differs in every texel, so a lookup one texel off shows.
     fn map(repr: Repr) -> TexelMap {

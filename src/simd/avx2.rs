@@ -147,6 +147,10 @@ impl Vector<NARROW> for Y {
             _mm256_cvtss_f32(v)
         }
     }
+    #[inline(always)]
+    fn trunc_u32(self, a: &mut [u32; NARROW]) {
+        unsafe { _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, _mm256_cvttps_epi32(self.0)) }
+    }
 }
 
 macro_rules! both {
@@ -226,6 +230,12 @@ impl Vector<WIDTH> for Y2 {
     #[inline(always)]
     fn reduce_max(self) -> f32 {
         self.0.max(self.1).reduce_max()
+    }
+    #[inline(always)]
+    fn trunc_u32(self, a: &mut [u32; WIDTH]) {
+        let (lo, hi) = a.split_at_mut(NARROW);
+        self.0.trunc_u32(lo.try_into().expect("8 lanes"));
+        self.1.trunc_u32(hi.try_into().expect("8 lanes"));
     }
 }
 

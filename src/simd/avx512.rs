@@ -131,6 +131,10 @@ impl Vector<WIDTH> for Z {
     fn reduce_max(self) -> f32 {
         unsafe { _mm512_reduce_max_ps(self.0) }
     }
+    #[inline(always)]
+    fn trunc_u32(self, a: &mut [u32; WIDTH]) {
+        unsafe { _mm512_storeu_si512(a.as_mut_ptr() as *mut _, _mm512_cvttps_epi32(self.0)) }
+    }
 }
 
 /// Sign bits of 16 lanes (avx512f has no movmskps for zmm: compare as integers against 0).

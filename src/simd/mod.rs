@@ -60,6 +60,9 @@ pub trait Vector<const N: usize>: Copy {
     fn reduce_min(self) -> f32;
     /// The largest lane (likewise).
     fn reduce_max(self) -> f32;
+    /// Each lane truncated toward zero, as `x as u32`, for lanes in [0, 2³¹) (the caller
+    /// clamps: outside that range the ISAs differ).
+    fn trunc_u32(self, a: &mut [u32; N]);
 }
 
 /// An f64 vector of `N` lanes, for the sample-path code whose numerics need f64 (sphere cones,
@@ -219,7 +222,12 @@ mod tests {
                 o
             })
             .collect();
-        (out, vec![x.lt(y), x.le(y), x.eq(y), x.sign()])
+        // Truncation on [0, 1e9] (in its range), after the masks.
+        let mut t = [0u32; N];
+        x.abs().min(V::splat(1e9)).trunc_u32(&mut t);
+        let mut bits = vec![x.lt(y), x.le(y), x.eq(y), x.sign()];
+        bits.extend(t);
+        (out, bits)
     }
 
     impl<const N: usize> Kernel for Probe<N> {

@@ -382,6 +382,12 @@ impl<const N: usize> Vector<N> for P<N> {
         m
     }
     #[inline(always)]
+    fn trunc_u32(self, a: &mut [u32; N]) {
+        for (o, x) in a.iter_mut().zip(self.0) {
+            *o = x as u32;
+        }
+    }
+    #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
         P(std::array::from_fn(|i| {
             if m & (1 << i) != 0 { a.0[i] } else { b.0[i] }
@@ -557,5 +563,9 @@ impl Vector<1> for f32 {
     #[inline(always)]
     fn reduce_max(self) -> f32 {
         self
+    }
+    #[inline(always)]
+    fn trunc_u32(self, a: &mut [u32; 1]) {
+        a[0] = self as u32;
     }
 }
