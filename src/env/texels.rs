@@ -148,6 +148,10 @@ pub struct ImportanceMap {
     weights: Vec<f32>,
     /// Density over the atlas of each texel, (w_k / Σw) · texel count (the sum in f64).
     density: Vec<f32>,
+    /// Per texel its radiance and density in one 16-byte record: the sampler over lanes
+    /// reads one cache line per lane instead of three (radiance, density, weight). Density
+    /// is positive exactly where the weight is (it is at least the weight: Σw ≤ the count).
+    record: Vec<[f32; 4]>,
     /// ∫ luminance(L) dω over the sphere (≈ Σ weights / texel count, before scaling).
     pub luminance_integral: f64,
     /// None for a black map: nothing to sample.
@@ -186,6 +190,12 @@ impl ImportanceMap {
                 }
             })
             .collect();
+        let record = texels
+            .texels
+            .iter()
+            .zip(&density)
+            .map(|(l, &d)| [l.x, l.y, l.z, d])
+            .collect();
         let as_f64: Vec<f64> = weights.iter().map(|&w| w as f64).collect();
         let cdf = MarginalConditional::new(&as_f64, texels.width);
         let hier = HierarchicalWarp::new(&weights, texels.repr.tiles(), texels.height);
@@ -193,6 +203,7 @@ impl ImportanceMap {
             luminance_integral: exact.iter().sum::<f64>() / count,
             weights,
             density,
+            record,
             cdf,
             hier,
             texels,
@@ -279,9 +290,11 @@ impl ImportanceMap {
         let mut density = [0.0f32; WIDTH];
         let mut positive = 0u32;
         for i in 0..WIDTH {
-            out.radiance.set(i, t.texels[k[i]]);
-            density[i] = self.density[k[i]];
-            positive |= ((self.weights[k[i]] > 0.0) as u32) << i;
+            let [r, g, b, d] = self.record[k[i]];
+            out.radiance.set(i, Vec3::new(r, g, b));
+            density[i] = d;
+            // As the scalar sampler's weight > 0 (see `record`).
+            positive |= ((d > 0.0) as u32) << i;
         }
         let zero = V::splat(0.0);
         out.valid = active & positive & !jac.le(zero);
@@ -324,7 +337,7 @@ impl ImportanceMap {
                 let mut density = [0.0f32; WIDTH];
                 for lane in 0..WIDTH {
                     if mask >> lane & 1 != 0 {
-                        density[lane] = map.density[k[lane]];
+                        density[lane] = map.record[k[lane]][3];
                     }
                 }
                 // J ≤ 0 (at the poles) has pdf 0, as in the scalar pdf; other lanes divide by 1.
