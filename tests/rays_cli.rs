@@ -69,6 +69,22 @@ fn rays_writes_csv() {
         assert!(csv.contains(&format!("obvhs,scalar,{class}")), "{csv}");
         assert!(csv.contains(&format!("packet,portable,{class}")), "{csv}");
     }
+    // Every subject's build time, the same on each of its rows.
+    let build = header.split(',').position(|c| c == "build_s").unwrap();
+    let mut seen: Vec<(String, String, String)> = vec![];
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        let s: f64 = f[build].parse().unwrap();
+        assert!(s > 0.0 && s.is_finite(), "{line}");
+        let key = (f[1].to_string(), f[2].to_string(), f[build].to_string());
+        if !seen.contains(&key) {
+            assert!(
+                !seen.iter().any(|k| (&k.0, &k.1) == (&key.0, &key.1)),
+                "two build times for {key:?}: {csv}"
+            );
+            seen.push(key);
+        }
+    }
 }
 
 /// `--class` times only the named ray classes, and an unknown one is an error naming the

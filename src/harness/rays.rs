@@ -235,16 +235,16 @@ impl std::fmt::Display for RaysReport {
             )?;
         }
         // Each subject's build, once (its rows of every class carry it).
-        let mut builds: Vec<String> = vec![];
+        let mut builds: Vec<(&str, &str, f64)> = vec![];
         for r in rows {
-            let b = format!("{} {} {:.1} ms", r.backend, r.isa, r.build_s * 1e3);
-            if !builds
-                .iter()
-                .any(|x| x.starts_with(&format!("{} {} ", r.backend, r.isa)))
-            {
-                builds.push(b);
+            if !builds.iter().any(|b| (b.0, b.1) == (&r.backend, &r.isa)) {
+                builds.push((&r.backend, &r.isa, r.build_s));
             }
         }
+        let builds: Vec<String> = builds
+            .iter()
+            .map(|(backend, isa, s)| format!("{backend} {isa} {:.1} ms", s * 1e3))
+            .collect();
         writeln!(f, "build: {}", builds.join(" · "))?;
         for class in rows
             .iter()
