@@ -58,11 +58,7 @@ pub struct Emitters {
 impl Emitters {
     /// The triangles, then spheres, of `g` that emit (`prim_emitter`, by primitive id), as a
     /// geometry of their own; None when none does.
-    fn build(
-        g: &Geometry,
-        prim_emitter: &[Option<EmitterRef>],
-        make_tracer: &mut impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
-    ) -> Option<Self> {
+    fn geometry(g: &Geometry, prim_emitter: &[Option<EmitterRef>]) -> Option<Arc<Geometry>> {
         let emits = |prim: usize| prim_emitter[prim].is_some();
         let mut sub = Geometry::default();
         for (i, t) in g.triangles.iter().enumerate() {
@@ -75,9 +71,7 @@ impl Emitters {
                 sub.spheres.push(*s);
             }
         }
-        (sub.prim_count() > 0).then(|| Emitters {
-            tracer: make_tracer(Arc::new(sub)),
-        })
+        (sub.prim_count() > 0).then(|| Arc::new(sub))
     }
 }
 
@@ -252,7 +246,9 @@ impl PreparedScene {
         let triangle_normals = g.triangles.iter().map(|t| t.cross().normalize()).collect();
         let geometry = Arc::new(g);
         let tracer = make_tracer(geometry.clone());
-        let emitters = Emitters::build(&geometry, &prim_emitter, &mut make_tracer);
+        let emitters = Emitters::geometry(&geometry, &prim_emitter).map(|g| Emitters {
+            tracer: make_tracer(g),
+        });
         PreparedScene {
             world: World {
                 geometry,
@@ -271,18 +267,22 @@ impl PreparedScene {
     }
 
     /// Traces with the tracers `make_tracer` builds (the scene's and its emitters'), handing
-    /// back the ones it replaces.
+    /// back the ones it replaces; on an error nothing is replaced.
     pub fn replace_tracers(
         &mut self,
-        mut make_tracer: impl FnMut(Arc<Geometry>) -> Box<dyn Tracer>,
-    ) -> (Box<dyn Tracer>, Option<Emitters>) {
-        let tracer = make_tracer(self.world.geometry.clone());
-        let w = &self.world;
-        let emitters = Emitters::build(&w.geometry, &w.prim_emitter, &mut make_tracer);
-        (
+        mut make_tracer: impl FnMut(Arc<Geometry>) -> crate::error::Result<Box<dyn Tracer>>,
+    ) -> crate::error::Result<(Box<dyn Tracer>, Option<Emitters>)> {
+        let tracer = make_tracer(self.world.geometry.clone())?;
+        let emitters = match Emitters::geometry(&self.world.geometry, &self.world.prim_emitter) {
+            Some(g) => Some(Emitters {
+                tracer: make_tracer(g)?,
+            }),
+            None => None,
+        };
+        Ok((
             std::mem::replace(&mut self.tracer, tracer),
             std::mem::replace(&mut self.emitters, emitters),
-        )
+        ))
     }
 
     /// The scene as `integrand` sees it.

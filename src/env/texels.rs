@@ -146,11 +146,10 @@ pub struct ImportanceMap {
     /// both samplers and the pdf use these same values, so a texel is sampled exactly when
     /// its stated pdf is positive.
     weights: Vec<f32>,
-    /// Density over the atlas of each texel, (w_k / Σw) · texel count (the sum in f64).
-    density: Vec<f32>,
-    /// Per texel its radiance and density in one 16-byte record: the sampler over lanes
-    /// reads one cache line per lane instead of three (radiance, density, weight). Density
-    /// is positive exactly where the weight is (it is at least the weight: Σw ≤ the count).
+    /// Per texel its radiance and its density over the atlas, (w_k / Σw) · texel count (the
+    /// sum in f64), in one 16-byte record: the sampler over lanes reads one cache line per
+    /// lane instead of three (radiance, density, weight). The density is positive exactly
+    /// where the weight is (it is at least the weight: Σw ≤ the count).
     record: Vec<[f32; 4]>,
     /// ∫ luminance(L) dω over the sphere (≈ Σ weights / texel count, before scaling).
     pub luminance_integral: f64,
@@ -180,7 +179,7 @@ impl ImportanceMap {
         let weights: Vec<f32> = exact.iter().map(|&w| (w * scale) as f32).collect();
         let total: f64 = weights.iter().map(|&w| w as f64).sum();
         let count = weights.len() as f64;
-        let density = weights
+        let density: Vec<f32> = weights
             .iter()
             .map(|&w| {
                 if total > 0.0 {
@@ -202,12 +201,17 @@ impl ImportanceMap {
         ImportanceMap {
             luminance_integral: exact.iter().sum::<f64>() / count,
             weights,
-            density,
             record,
             cdf,
             hier,
             texels,
         }
+    }
+
+    /// Texel k's density over the atlas (see `record`).
+    #[inline(always)]
+    fn density(&self, k: usize) -> f32 {
+        self.record[k][3]
     }
 
     /// The atlas points (u, v) ∈ [0, 1)² of N lanes' hierarchical samples, in f32.
@@ -263,7 +267,7 @@ impl ImportanceMap {
         Some(EnvSample {
             wi: t.repr.uv_to_dir(uv),
             radiance: t.texels[k],
-            pdf: self.density[k] / jac,
+            pdf: self.density(k) / jac,
         })
     }
 
@@ -309,7 +313,7 @@ impl ImportanceMap {
         if jac <= 0.0 {
             return 0.0;
         }
-        self.density[self.texels.index(uv)] / jac
+        self.density(self.texels.index(uv)) / jac
     }
 
     /// [`Self::pdf`] of the directions `w` of lanes `mask` (0 in the others): over lanes for
@@ -337,7 +341,7 @@ impl ImportanceMap {
                 let mut density = [0.0f32; WIDTH];
                 for lane in 0..WIDTH {
                     if mask >> lane & 1 != 0 {
-                        density[lane] = map.record[k[lane]][3];
+                        density[lane] = map.density(k[lane]);
                     }
                 }
                 // J ≤ 0 (at the poles) has pdf 0, as in the scalar pdf; other lanes divide by 1.

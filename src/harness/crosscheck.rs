@@ -369,17 +369,8 @@ pub fn run(scene: &mut PreparedScene, out: &Path, seed: u64) -> Result<Report> {
     if let Some(strategy) = applicable.first() {
         let reference = render(scene, strategy.as_ref(), seed, RENDER_PASSES)?;
         for name in names.iter().skip(1) {
-            let mut err = None;
-            let (tracer, emitters) = scene.replace_tracers(|g| {
-                backends::build(name, g.clone()).unwrap_or_else(|e| {
-                    err = Some(e);
-                    backends::build("obvhs", g).expect("the obvhs backend always builds")
-                })
-            });
-            let img = match err {
-                Some(e) => Err(e),
-                None => render(scene, strategy.as_ref(), seed, RENDER_PASSES),
-            };
+            let (tracer, emitters) = scene.replace_tracers(|g| backends::build(name, g))?;
+            let img = render(scene, strategy.as_ref(), seed, RENDER_PASSES);
             (scene.tracer, scene.emitters) = (tracer, emitters);
             let img = img?;
             let d = image_rel_rmse(&reference, &img);
