@@ -68,6 +68,77 @@ position = [0.7, 1.1, 0.4]
 power = [4.0, 4.0, 4.0]
 "#;
 
+/// Sphere lights of different centres, radii and radiances over a floor, one of them
+/// enclosing the whole scene: packets whose lanes chose different spheres (each lane's own
+/// sphere in the cone kernel's records), some lanes inside their sphere.
+const SPHERES: &str = r#"
+[camera]
+eye = [0.2, 1.4, 3.5]
+look_at = [0.0, 0.2, 0.0]
+fov_y_deg = 55.0
+[image]
+width = 32
+height = 32
+[[material]]
+name = "floor"
+albedo = [0.6, 0.5, 0.4]
+[[material]]
+name = "lamp"
+albedo = [0.0, 0.0, 0.0]
+[[quad]]
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "floor"
+[[sphere]]
+center = [-0.6, 0.9, 0.1]
+radius = 0.13
+material = "lamp"
+emission = [9.0, 7.0, 5.0]
+[[sphere]]
+center = [0.5, 0.6, -0.3]
+radius = 0.31
+material = "lamp"
+emission = [2.0, 3.0, 4.0]
+[[sphere]]
+center = [0.3, 0.05, 0.9]
+radius = 0.45
+material = "lamp"
+emission = [0.5, 0.25, 0.125]
+[[sphere]]
+center = [0.0, 0.5, 0.0]
+radius = 20.0
+material = "lamp"
+emission = [0.05, 0.05, 0.05]
+"#;
+
+/// One emitting triangle (facing down, tilted) over a floor: the only light, so every lane
+/// holds it and it samples them itself.
+const ONE_TRIANGLE: &str = r#"
+[camera]
+eye = [0.2, 1.4, 3.5]
+look_at = [0.0, 0.2, 0.0]
+fov_y_deg = 55.0
+[image]
+width = 32
+height = 32
+[[material]]
+name = "floor"
+albedo = [0.6, 0.5, 0.4]
+[[material]]
+name = "lamp"
+albedo = [0.0, 0.0, 0.0]
+[[quad]]
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "floor"
+[[mesh]]
+file = "triangle.obj"
+material = "lamp"
+emission = [5.0, 4.0, 3.0]
+"#;
+
 fn scenes() -> Vec<(String, PreparedScene)> {
     let mut v: Vec<(String, PreparedScene)> = SCENES
         .iter()
@@ -82,6 +153,15 @@ fn scenes() -> Vec<(String, PreparedScene)> {
     let dir = tempfile::tempdir().unwrap();
     let scene = Scene::parse(TILTED, &dir.path().join("tilted.toml")).unwrap();
     v.push(("tilted".into(), PreparedScene::new(scene)));
+    let scene = Scene::parse(SPHERES, &dir.path().join("spheres.toml")).unwrap();
+    v.push(("spheres".into(), PreparedScene::new(scene)));
+    std::fs::write(
+        dir.path().join("triangle.obj"),
+        "v -0.4 1.3 0.2\nv 0.5 1.1 -0.3\nv 0.1 1.5 0.6\nf 1 2 3\n",
+    )
+    .unwrap();
+    let scene = Scene::parse(ONE_TRIANGLE, &dir.path().join("one_triangle.toml")).unwrap();
+    v.push(("one_triangle".into(), PreparedScene::new(scene)));
     v
 }
 

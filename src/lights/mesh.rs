@@ -198,6 +198,21 @@ fn area_lanes<V: Vector<WIDTH>>(r: &LaneRecords, q: &LaneQuery, a: u32, out: &mu
 }
 
 impl Light for TriangleLight {
+    /// Area sampling through its kernel over records, this triangle's record in every lane.
+    fn sample_lanes(
+        &self,
+        isa: Isa,
+        q: &LaneQuery,
+        active: u32,
+        m: &LightMethods,
+        out: &mut LaneSamples,
+    ) {
+        match self.lane_record(m) {
+            Some((k, r)) => (k.sample)(isa, &r.map(|v| [v; WIDTH]), q, active, m, out),
+            None => super::sample_lane_by_lane(self, q, active, m, out),
+        }
+    }
+
     fn lane_record(&self, m: &LightMethods) -> Option<(&'static LaneKernel, [f32; LANE_RECORD])> {
         if m.mesh != MeshMethod::Area {
             return None;

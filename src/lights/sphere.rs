@@ -6,8 +6,9 @@
 
 use super::bounds::{Bounds, LightBounds};
 use super::{
-    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
-    SphereMethod, d64, direction_to, f32s, keep, sample_lane_by_lane,
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
+    LightMethods, LightSample, LightShape, SphereMethod, d64, direction_to, f32s, keep,
+    sample_lane_by_lane,
 };
 use crate::math::{Frame, gamma, luminance};
 use crate::sampling::warp::{
@@ -92,78 +93,7 @@ impl SphereLight {
         a: u32,
         out: &mut LaneSamples,
     ) -> u32 {
-        let c = self.center.as_dvec3();
-        let r = self.radius as f64;
-        let r2 = r * r;
-        // cone_extent
-        let to_c = [
-            D::splat(c.x).sub(D::from_f32(&q.p.x)),
-            D::splat(c.y).sub(D::from_f32(&q.p.y)),
-            D::splat(c.z).sub(D::from_f32(&q.p.z)),
-        ];
-        let d2 = to_c[0]
-            .mul(to_c[0])
-            .add(to_c[1].mul(to_c[1]))
-            .add(to_c[2].mul(to_c[2]));
-        let inside = a & d2.le(D::splat(r2));
-        let outside = a & !inside;
-        // Lanes inside take 2r² + 1 > r² instead, so that no lane divides by zero or takes a
-        // square root of a negative number; their results are not used.
-        let d2 = D::select(inside, D::splat(2.0 * r2 + 1.0), d2);
-        let one = D::splat(1.0);
-        let omc_max = D::splat(r2)
-            .div(d2)
-            .div(one.add(d2.sub(D::splat(r2)).div(d2).sqrt()));
-        // sample_cone
-        let dc = d2.sqrt();
-        let axis = V3 {
-            x: f32s::<V, D>(to_c[0].div(dc)),
-            y: f32s::<V, D>(to_c[1].div(dc)),
-            z: f32s::<V, D>(to_c[2].div(dc)),
-        };
-        let (fs, ft) = Frame::from_normal_lanes(axis);
-        let omc32 = f32s::<V, D>(omc_max);
-        let (lx32, ly32, lz32) = uniform_cone(V::load(&q.u[0]), V::load(&q.u[1]), omc32);
-        let (lx, ly, cos_t) = (d64::<V, D>(lx32), d64::<V, D>(ly32), d64::<V, D>(lz32));
-        let sin2_t = lx.mul(lx).add(ly.mul(ly));
-        let t = d2.sub(D::splat(r * r)).div(
-            dc.mul(cos_t).add(
-                D::splat(r * r)
-                    .sub(d2.mul(sin2_t))
-                    .max(D::splat(0.0))
-                    .sqrt(),
-            ),
-        );
-        let sin_t = sin2_t.sqrt();
-        let sin_a = t.mul(sin_t).div(D::splat(r)).min(one);
-        let cos_a = one.sub(sin_a.mul(sin_a)).sqrt();
-        let turned = D::splat(0.0).lt(sin_t);
-        let den = D::select(turned, sin_t, one);
-        let cos_phi = D::select(turned, lx.div(den), one);
-        let sin_phi = D::select(turned, ly.div(den), D::splat(0.0));
-        let (nx, ny, nz) = (
-            f32s::<V, D>(sin_a.mul(cos_phi)),
-            f32s::<V, D>(sin_a.mul(sin_phi)),
-            f32s::<V, D>(cos_a).neg(),
-        );
-        // Frame::to_world in glam's order.
-        let normal = fs.scale(nx) + ft.scale(ny) + axis.scale(nz);
-        let centre = V3::<V>::splat(self.center);
-        let point = centre + normal.scale(V::splat(self.radius));
-        let wi = fs.scale(lx32) + ft.scale(ly32) + axis.scale(lz32);
-        // Sphere::point_error
-        let error = (point - centre).abs().scale(V::splat(gamma(6)))
-            + V3::splat(self.center.abs()).scale(V::splat(gamma(1)));
-        let pdf = V::splat(1.0).div(V::splat(2.0 * PI).mul(omc32));
-        keep(outside, wi, &mut out.wi);
-        keep(outside, point, &mut out.point);
-        keep(outside, normal, &mut out.normal);
-        keep(outside, error, &mut out.point_error);
-        keep(outside, V3::<V>::splat(self.radiance), &mut out.radiance);
-        V::select(outside, pdf, V::load(&out.pdf)).store(&mut out.pdf);
-        out.valid |= outside;
-        out.distant &= !outside;
-        inside
+        cone_lanes::<V, D>(self, q, a, out)
     }
 
     /// Solid-angle pdf of [`Self::sample_cone`] for the direction from p to the light point q.
@@ -392,6 +322,17 @@ impl Light for SphereLight {
         }
     }
 
+    fn lane_record(&self, m: &LightMethods) -> Option<(&'static LaneKernel, [f32; LANE_RECORD])> {
+        if m.sphere != SphereMethod::Cone {
+            return None;
+        }
+        let mut r = [0.0; LANE_RECORD];
+        r[0..3].copy_from_slice(&self.center.to_array());
+        r[3] = self.radius;
+        r[4..7].copy_from_slice(&self.radiance.to_array());
+        Some((&CONE_LANES, r))
+    }
+
     /// Cone sampling over lanes for points outside the sphere; lane by lane otherwise.
     fn sample_lanes(
         &self,
@@ -431,6 +372,186 @@ impl Light for SphereLight {
     /// Two-sided: the inward face lights points inside the sphere.
     fn emitted(&self, _n: Vec3, _w: Vec3, _local: u32) -> Vec3 {
         self.radiance
+    }
+}
+
+/// Where [`cone_lanes`] reads its spheres: one sphere for every lane (constants), or each
+/// lane's own (rows of records). Read where used, as f32 lanes or exactly as f64 lanes.
+trait SphereLanes<V: Vector<WIDTH>, D: Vector64<WIDTH>> {
+    fn center_d(&self, k: usize) -> D;
+    fn radius_d(&self) -> D;
+    fn center(&self) -> V3<V>;
+    fn radius(&self) -> V;
+    fn radiance(&self) -> V3<V>;
+}
+
+impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for SphereLight {
+    #[inline(always)]
+    fn center_d(&self, k: usize) -> D {
+        D::splat(self.center[k] as f64)
+    }
+    #[inline(always)]
+    fn radius_d(&self) -> D {
+        D::splat(self.radius as f64)
+    }
+    #[inline(always)]
+    fn center(&self) -> V3<V> {
+        V3::splat(self.center)
+    }
+    #[inline(always)]
+    fn radius(&self) -> V {
+        V::splat(self.radius)
+    }
+    #[inline(always)]
+    fn radiance(&self) -> V3<V> {
+        V3::splat(self.radiance)
+    }
+}
+
+/// A sphere record's fields: centre (0..3), radius (3), radiance (4..7).
+impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for LaneRecords {
+    #[inline(always)]
+    fn center_d(&self, k: usize) -> D {
+        D::from_f32(&self[k])
+    }
+    #[inline(always)]
+    fn radius_d(&self) -> D {
+        D::from_f32(&self[3])
+    }
+    #[inline(always)]
+    fn center(&self) -> V3<V> {
+        V3 {
+            x: V::load(&self[0]),
+            y: V::load(&self[1]),
+            z: V::load(&self[2]),
+        }
+    }
+    #[inline(always)]
+    fn radius(&self) -> V {
+        V::load(&self[3])
+    }
+    #[inline(always)]
+    fn radiance(&self) -> V3<V> {
+        V3 {
+            x: V::load(&self[4]),
+            y: V::load(&self[5]),
+            z: V::load(&self[6]),
+        }
+    }
+}
+
+/// [`SphereLight::sample_cone`] of each lane's sphere for the lanes of `a` whose point is
+/// outside it, over lanes, the same operations in the same order (the f64 parts in f64
+/// lanes); returns the lanes of `a` inside their sphere, which the caller samples one at a
+/// time. Other lanes of `out` are kept.
+#[inline(always)]
+fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+    s: &impl SphereLanes<V, D>,
+    q: &LaneQuery,
+    a: u32,
+    out: &mut LaneSamples,
+) -> u32 {
+    let r = s.radius_d();
+    let r2 = r.mul(r);
+    // cone_extent
+    let to_c = [
+        s.center_d(0).sub(D::from_f32(&q.p.x)),
+        s.center_d(1).sub(D::from_f32(&q.p.y)),
+        s.center_d(2).sub(D::from_f32(&q.p.z)),
+    ];
+    let d2 = to_c[0]
+        .mul(to_c[0])
+        .add(to_c[1].mul(to_c[1]))
+        .add(to_c[2].mul(to_c[2]));
+    let inside = a & d2.le(r2);
+    let outside = a & !inside;
+    // Lanes inside take 2r² + 1 > r² instead, so that no lane divides by zero or takes a
+    // square root of a negative number; their results are not used.
+    let one = D::splat(1.0);
+    let d2 = D::select(inside, D::splat(2.0).mul(r2).add(one), d2);
+    let omc_max = r2.div(d2).div(one.add(d2.sub(r2).div(d2).sqrt()));
+    // sample_cone
+    let dc = d2.sqrt();
+    let axis = V3 {
+        x: f32s::<V, D>(to_c[0].div(dc)),
+        y: f32s::<V, D>(to_c[1].div(dc)),
+        z: f32s::<V, D>(to_c[2].div(dc)),
+    };
+    let (fs, ft) = Frame::from_normal_lanes(axis);
+    let omc32 = f32s::<V, D>(omc_max);
+    let (lx32, ly32, lz32) = uniform_cone(V::load(&q.u[0]), V::load(&q.u[1]), omc32);
+    let (lx, ly, cos_t) = (d64::<V, D>(lx32), d64::<V, D>(ly32), d64::<V, D>(lz32));
+    let sin2_t = lx.mul(lx).add(ly.mul(ly));
+    let t = d2.sub(r2).div(
+        dc.mul(cos_t)
+            .add(r2.sub(d2.mul(sin2_t)).max(D::splat(0.0)).sqrt()),
+    );
+    let sin_t = sin2_t.sqrt();
+    let sin_a = t.mul(sin_t).div(r).min(one);
+    let cos_a = one.sub(sin_a.mul(sin_a)).sqrt();
+    let turned = D::splat(0.0).lt(sin_t);
+    let den = D::select(turned, sin_t, one);
+    let cos_phi = D::select(turned, lx.div(den), one);
+    let sin_phi = D::select(turned, ly.div(den), D::splat(0.0));
+    let (nx, ny, nz) = (
+        f32s::<V, D>(sin_a.mul(cos_phi)),
+        f32s::<V, D>(sin_a.mul(sin_phi)),
+        f32s::<V, D>(cos_a).neg(),
+    );
+    // Frame::to_world in glam's order.
+    let normal = fs.scale(nx) + ft.scale(ny) + axis.scale(nz);
+    let centre = s.center();
+    let point = centre + normal.scale(s.radius());
+    let wi = fs.scale(lx32) + ft.scale(ly32) + axis.scale(lz32);
+    // Sphere::point_error
+    let error =
+        (point - centre).abs().scale(V::splat(gamma(6))) + centre.abs().scale(V::splat(gamma(1)));
+    let pdf = V::splat(1.0).div(V::splat(2.0 * PI).mul(omc32));
+    keep(outside, wi, &mut out.wi);
+    keep(outside, point, &mut out.point);
+    keep(outside, normal, &mut out.normal);
+    keep(outside, error, &mut out.point_error);
+    keep(outside, s.radiance(), &mut out.radiance);
+    V::select(outside, pdf, V::load(&out.pdf)).store(&mut out.pdf);
+    out.valid |= outside;
+    out.distant &= !outside;
+    inside
+}
+
+/// Cone sampling of spheres with each lane's own sphere (its record: centre, radius,
+/// radiance), over lanes; lanes inside their sphere one at a time.
+static CONE_LANES: LaneKernel = LaneKernel {
+    name: "spheres in the cone",
+    sample: sample_cone_records,
+};
+
+fn sample_cone_records(
+    isa: Isa,
+    records: &LaneRecords,
+    q: &LaneQuery,
+    active: u32,
+    m: &LightMethods,
+    out: &mut LaneSamples,
+) {
+    struct Cone<'a>(&'a LaneRecords, &'a LaneQuery, u32, &'a mut LaneSamples);
+    impl Kernel for Cone<'_> {
+        type Out = u32;
+        #[inline(always)]
+        fn run<L: Lanes>(self) -> u32 {
+            cone_lanes::<L::V, L::D>(self.0, self.1, self.2, self.3)
+        }
+    }
+    let mut inside = simd::run(isa, Cone(records, q, active, out));
+    while inside != 0 {
+        let lane = inside.trailing_zeros() as usize;
+        inside &= inside - 1;
+        let f = |k: usize| records[k][lane];
+        let sphere = SphereLight {
+            center: Vec3::new(f(0), f(1), f(2)),
+            radius: f(3),
+            radiance: Vec3::new(f(4), f(5), f(6)),
+        };
+        sample_lane_by_lane(&sphere, q, 1 << lane, m, out);
     }
 }
 

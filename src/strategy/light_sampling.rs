@@ -427,8 +427,9 @@ impl<'s> BoundLights<'s> {
             geo: &packet.geo,
         };
         let chosen;
+        let constant = self.selector.constant();
         // One dynamic call per packet, not per lane, where the choice cannot vary (one light).
-        if let Some((i, pmf)) = self.selector.constant() {
+        if let Some((i, pmf)) = constant {
             chosen = packet.mask;
             *light = [i; LANES];
             x.pmf = [pmf; WIDTH];
@@ -450,14 +451,16 @@ impl<'s> BoundLights<'s> {
             }
             chosen = c;
         }
-        // Lights with a kernel over lanes of different lights (mesh triangles) hand over their
-        // records; each such kernel samples all its lanes at once.
+        // Lights with a kernel over lanes of different lights (mesh triangles, spheres) hand
+        // over their records; each such kernel samples all its lanes at once. One light for
+        // every lane samples them itself below ([`Light::sample_lanes`], its parameters
+        // constants).
         let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
         // On the stack, zeroed only when a lane has a kernel (a heap record was a malloc and a
         // free per packet: 2.4 % of a mesh_light `light` pass).
         let mut records: Option<LaneRecords> = None;
         let mut with_kernel = 0u32;
-        let mut rest = chosen;
+        let mut rest = if constant.is_some() { 0 } else { chosen };
         while rest != 0 {
             let lane = rest.trailing_zeros() as usize;
             rest &= rest - 1;
