@@ -4,8 +4,8 @@
 
 use super::bounds::{Bounds, LightBounds};
 use super::{
-    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
-    QuadMethod, SurfaceLanes, d64, direction_to, f32s, keep,
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
+    LightMethods, LightSample, LightShape, QuadMethod, SurfaceLanes, d64, direction_to, f32s, keep,
 };
 use crate::math::gamma;
 use crate::math::luminance;
@@ -65,27 +65,7 @@ impl QuadLight {
     /// in the same order over lanes; other lanes of `out` are kept.
     #[inline(always)]
     fn sample_area_lanes<V: Vector<WIDTH>>(&self, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
-        let zero = V::splat(0.0);
-        let (u0, u1) = (V::load(&q.u[0]), V::load(&q.u[1]));
-        let eu = V3::splat(self.edge_u).scale(u0);
-        let ev = V3::splat(self.edge_v).scale(u1);
-        let point = V3::splat(self.corner) + eu + ev;
-        // direction_to
-        let d = point - V3::load(&q.p);
-        let d2 = d.dot(d);
-        let wi = d / d2.sqrt();
-        let cos_l = V3::splat(self.normal).dot(wi).neg();
-        let valid = a & zero.lt(d2) & !cos_l.le(zero);
-        let error = (V3::splat(self.corner.abs()) + eu.abs() + ev.abs()).scale(V::splat(gamma(6)));
-        let pdf = d2.div(V::splat(self.area).mul(cos_l));
-        keep(a, wi, &mut out.wi);
-        keep(a, point, &mut out.point);
-        keep(a, V3::<V>::splat(self.normal), &mut out.normal);
-        keep(a, error, &mut out.point_error);
-        keep(a, V3::<V>::splat(self.radiance), &mut out.radiance);
-        V::select(a, pdf, V::load(&out.pdf)).store(&mut out.pdf);
-        out.valid = (out.valid & !a) | valid;
-        out.distant &= !a;
+        area_lanes::<V>(self, q, a, out)
     }
 
     /// Solid-angle pdf of [`Self::sample_area`] for the direction that reaches light point q.
@@ -145,9 +125,8 @@ impl QuadLight {
         })
     }
 
-    /// [`Self::sample_solid_angle`] for the lanes of `a` (u = `q.u[0..2]`), bit for bit: the
-    /// same spherical rectangle over f64 lanes, area sampling ([`Self::sample_area_lanes`])
-    /// for the lanes that fall back to it; other lanes of `out` are kept.
+    /// [`Self::sample_solid_angle`] for the lanes of `a` (u = `q.u[0..2]`), bit for bit; other
+    /// lanes of `out` are kept.
     #[inline(always)]
     fn sample_solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
         &self,
@@ -155,59 +134,7 @@ impl QuadLight {
         a: u32,
         out: &mut LaneSamples,
     ) {
-        let p = V3::<V>::load(&q.p);
-        let (rect, faces, solid) = self.spherical_rect_lanes::<V, D>(p, a);
-        let d = rect.sample_lanes(D::from_f32(&q.u[0]), D::from_f32(&q.u[1]));
-        let dist = dot3(d, d).sqrt();
-        let wi = V3 {
-            x: f32s::<V, D>(d[0].div(dist)),
-            y: f32s::<V, D>(d[1].div(dist)),
-            z: f32s::<V, D>(d[2].div(dist)),
-        };
-        let d32 = V3 {
-            x: f32s::<V, D>(d[0]),
-            y: f32s::<V, D>(d[1]),
-            z: f32s::<V, D>(d[2]),
-        };
-        let point = p + d32;
-        let error = (p.abs() + d32.abs()).scale(V::splat(gamma(3)));
-        let pdf = f32s::<V, D>(D::splat(1.0).div(rect.area()));
-        keep(solid, wi, &mut out.wi);
-        keep(solid, point, &mut out.point);
-        keep(solid, V3::<V>::splat(self.normal), &mut out.normal);
-        keep(solid, error, &mut out.point_error);
-        keep(solid, V3::<V>::splat(self.radiance), &mut out.radiance);
-        V::select(solid, pdf, V::load(&out.pdf)).store(&mut out.pdf);
-        // Lanes behind the light have no sample; tiny rectangles are sampled by area.
-        out.valid = (out.valid & !(a & !faces)) | solid;
-        out.distant &= !solid;
-        self.sample_area_lanes::<V>(q, faces & !solid, out);
-    }
-
-    /// [`Self::faces`] and [`Self::spherical_rect`] for the lanes of `a` seen from `p`: the
-    /// rectangles, the lanes that face the emitting side, and those of them whose rectangle
-    /// is sampled (the others fall back to area sampling). Other lanes' rectangles hold finite
-    /// values that mean nothing.
-    #[inline(always)]
-    fn spherical_rect_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-        &self,
-        p: V3<V>,
-        a: u32,
-    ) -> (SphericalRectangle<D>, u32, u32) {
-        let corner32 = V3::splat(self.corner);
-        let faces = a & V::splat(0.0).lt((p - corner32).dot(V3::splat(self.normal)));
-        // The corner relative to p, rounded in f32 and then widened.
-        let rel = corner32 - p;
-        let corner = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
-        let n = self.normal.as_dvec3().to_array().map(D::splat);
-        let front = dot3(corner, n).lt(D::splat(0.0));
-        let (ex, ey) = (
-            self.edge_u.as_dvec3().to_array().map(D::splat),
-            self.edge_v.as_dvec3().to_array().map(D::splat),
-        );
-        let (rect, ok) = SphericalRectangle::<D>::lanes(corner, ex, ey);
-        let solid = faces & front & ok & D::splat(MIN_SOLID_ANGLE).le(rect.area());
-        (rect, faces, solid)
+        solid_angle_lanes::<V, D>(self, q, a, out)
     }
 
     /// [`Self::pdf_area`] of every lane of `at`, the same operations in the same order (lanes
@@ -231,7 +158,7 @@ impl QuadLight {
         out: &mut [f32; WIDTH],
     ) {
         let zero = V::splat(0.0);
-        let (rect, faces, solid) = self.spherical_rect_lanes::<V, D>(V3::load(&at.from.p), a);
+        let (rect, faces, solid) = rect_lanes::<V, D>(self, V3::load(&at.from.p), a);
         let mut pdf = V::select(solid, f32s::<V, D>(D::splat(1.0).div(rect.area())), zero);
         // Tiny rectangles were sampled by area (rare: only then is that pdf computed).
         let by_area = faces & !solid;
@@ -257,7 +184,264 @@ impl QuadLight {
     }
 }
 
+/// Where the lane kernels read their quads: one quad for every lane (constants), or each
+/// lane's own (rows of a record: corner 0..3, edge_u 3..6, edge_v 6..9, normal 9..12, area 12,
+/// radiance 13..16). Read where used, as f32 lanes or exactly as f64 lanes.
+trait QuadLanes<V: Vector<WIDTH>> {
+    fn corner(&self) -> V3<V>;
+    fn edge_u(&self) -> V3<V>;
+    fn edge_v(&self) -> V3<V>;
+    fn normal(&self) -> V3<V>;
+    fn area(&self) -> V;
+    fn radiance(&self) -> V3<V>;
+    fn edge_u_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
+    fn edge_v_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
+    fn normal_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
+}
+
+impl<V: Vector<WIDTH>> QuadLanes<V> for QuadLight {
+    #[inline(always)]
+    fn corner(&self) -> V3<V> {
+        V3::splat(self.corner)
+    }
+    #[inline(always)]
+    fn edge_u(&self) -> V3<V> {
+        V3::splat(self.edge_u)
+    }
+    #[inline(always)]
+    fn edge_v(&self) -> V3<V> {
+        V3::splat(self.edge_v)
+    }
+    #[inline(always)]
+    fn normal(&self) -> V3<V> {
+        V3::splat(self.normal)
+    }
+    #[inline(always)]
+    fn area(&self) -> V {
+        V::splat(self.area)
+    }
+    #[inline(always)]
+    fn radiance(&self) -> V3<V> {
+        V3::splat(self.radiance)
+    }
+    #[inline(always)]
+    fn edge_u_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        self.edge_u.as_dvec3().to_array().map(D::splat)
+    }
+    #[inline(always)]
+    fn edge_v_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        self.edge_v.as_dvec3().to_array().map(D::splat)
+    }
+    #[inline(always)]
+    fn normal_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        self.normal.as_dvec3().to_array().map(D::splat)
+    }
+}
+
+/// Rows `k..k + 3` of a record as f32 lanes.
+#[inline(always)]
+fn rows<V: Vector<WIDTH>>(r: &LaneRecords, k: usize) -> V3<V> {
+    V3 {
+        x: V::load(&r[k]),
+        y: V::load(&r[k + 1]),
+        z: V::load(&r[k + 2]),
+    }
+}
+
+/// Rows `k..k + 3` of a record, exactly, as f64 lanes.
+#[inline(always)]
+fn rows_d<D: Vector64<WIDTH>>(r: &LaneRecords, k: usize) -> [D; 3] {
+    [
+        D::from_f32(&r[k]),
+        D::from_f32(&r[k + 1]),
+        D::from_f32(&r[k + 2]),
+    ]
+}
+
+impl<V: Vector<WIDTH>> QuadLanes<V> for LaneRecords {
+    #[inline(always)]
+    fn corner(&self) -> V3<V> {
+        rows(self, 0)
+    }
+    #[inline(always)]
+    fn edge_u(&self) -> V3<V> {
+        rows(self, 3)
+    }
+    #[inline(always)]
+    fn edge_v(&self) -> V3<V> {
+        rows(self, 6)
+    }
+    #[inline(always)]
+    fn normal(&self) -> V3<V> {
+        rows(self, 9)
+    }
+    #[inline(always)]
+    fn area(&self) -> V {
+        V::load(&self[12])
+    }
+    #[inline(always)]
+    fn radiance(&self) -> V3<V> {
+        rows(self, 13)
+    }
+    #[inline(always)]
+    fn edge_u_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        rows_d(self, 3)
+    }
+    #[inline(always)]
+    fn edge_v_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        rows_d(self, 6)
+    }
+    #[inline(always)]
+    fn normal_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        rows_d(self, 9)
+    }
+}
+
+/// [`QuadLight::sample_area`] of each lane's quad for the lanes of `a` (u = `q.u[0..2]`), the
+/// same operations in the same order over lanes; other lanes of `out` are kept.
+#[inline(always)]
+fn area_lanes<V: Vector<WIDTH>>(
+    s: &impl QuadLanes<V>,
+    q: &LaneQuery,
+    a: u32,
+    out: &mut LaneSamples,
+) {
+    let zero = V::splat(0.0);
+    let (u0, u1) = (V::load(&q.u[0]), V::load(&q.u[1]));
+    let eu = s.edge_u().scale(u0);
+    let ev = s.edge_v().scale(u1);
+    let point = s.corner() + eu + ev;
+    // direction_to
+    let d = point - V3::load(&q.p);
+    let d2 = d.dot(d);
+    let wi = d / d2.sqrt();
+    let cos_l = s.normal().dot(wi).neg();
+    let valid = a & zero.lt(d2) & !cos_l.le(zero);
+    let error = (s.corner().abs() + eu.abs() + ev.abs()).scale(V::splat(gamma(6)));
+    let pdf = d2.div(s.area().mul(cos_l));
+    keep(a, wi, &mut out.wi);
+    keep(a, point, &mut out.point);
+    keep(a, s.normal(), &mut out.normal);
+    keep(a, error, &mut out.point_error);
+    keep(a, s.radiance(), &mut out.radiance);
+    V::select(a, pdf, V::load(&out.pdf)).store(&mut out.pdf);
+    out.valid = (out.valid & !a) | valid;
+    out.distant &= !a;
+}
+
+/// [`QuadLight::sample_solid_angle`] of each lane's quad for the lanes of `a` (u =
+/// `q.u[0..2]`), bit for bit: the same spherical rectangle over f64 lanes, area sampling
+/// ([`area_lanes`]) for the lanes that fall back to it; other lanes of `out` are kept.
+#[inline(always)]
+fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+    s: &impl QuadLanes<V>,
+    q: &LaneQuery,
+    a: u32,
+    out: &mut LaneSamples,
+) {
+    let p = V3::<V>::load(&q.p);
+    let (rect, faces, solid) = rect_lanes::<V, D>(s, p, a);
+    let d = rect.sample_lanes(D::from_f32(&q.u[0]), D::from_f32(&q.u[1]));
+    let dist = dot3(d, d).sqrt();
+    let wi = V3 {
+        x: f32s::<V, D>(d[0].div(dist)),
+        y: f32s::<V, D>(d[1].div(dist)),
+        z: f32s::<V, D>(d[2].div(dist)),
+    };
+    let d32 = V3 {
+        x: f32s::<V, D>(d[0]),
+        y: f32s::<V, D>(d[1]),
+        z: f32s::<V, D>(d[2]),
+    };
+    let point = p + d32;
+    let error = (p.abs() + d32.abs()).scale(V::splat(gamma(3)));
+    let pdf = f32s::<V, D>(D::splat(1.0).div(rect.area()));
+    keep(solid, wi, &mut out.wi);
+    keep(solid, point, &mut out.point);
+    keep(solid, s.normal(), &mut out.normal);
+    keep(solid, error, &mut out.point_error);
+    keep(solid, s.radiance(), &mut out.radiance);
+    V::select(solid, pdf, V::load(&out.pdf)).store(&mut out.pdf);
+    // Lanes behind the light have no sample; tiny rectangles are sampled by area.
+    out.valid = (out.valid & !(a & !faces)) | solid;
+    out.distant &= !solid;
+    area_lanes::<V>(s, q, faces & !solid, out);
+}
+
+/// [`QuadLight::faces`] and [`QuadLight::spherical_rect`] of each lane's quad for the lanes of
+/// `a` seen from `p`: the rectangles, the lanes that face the emitting side, and those of them
+/// whose rectangle is sampled (the others fall back to area sampling). Other lanes' rectangles
+/// hold finite values that mean nothing.
+#[inline(always)]
+fn rect_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+    s: &impl QuadLanes<V>,
+    p: V3<V>,
+    a: u32,
+) -> (SphericalRectangle<D>, u32, u32) {
+    let corner32 = s.corner();
+    let faces = a & V::splat(0.0).lt((p - corner32).dot(s.normal()));
+    // The corner relative to p, rounded in f32 and then widened.
+    let rel = corner32 - p;
+    let corner = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
+    let n = s.normal_d::<D>();
+    let front = dot3(corner, n).lt(D::splat(0.0));
+    let (ex, ey) = (s.edge_u_d::<D>(), s.edge_v_d::<D>());
+    let (rect, ok) = SphericalRectangle::<D>::lanes(corner, ex, ey);
+    let solid = faces & front & ok & D::splat(MIN_SOLID_ANGLE).le(rect.area());
+    (rect, faces, solid)
+}
+
+/// Quads sampled over lanes of different quads (each lane's quad in a record), by the
+/// method `m` picks: by area, or in the solid angle.
+static QUAD_LANES: LaneKernel = LaneKernel {
+    name: "quads",
+    sample: sample_quad_records,
+};
+
+fn sample_quad_records(
+    isa: Isa,
+    records: &LaneRecords,
+    q: &LaneQuery,
+    active: u32,
+    m: &LightMethods,
+    out: &mut LaneSamples,
+) {
+    struct Records<'a>(
+        &'a LaneRecords,
+        &'a LaneQuery,
+        u32,
+        QuadMethod,
+        &'a mut LaneSamples,
+    );
+    impl Kernel for Records<'_> {
+        type Out = ();
+        #[inline(always)]
+        fn run<L: Lanes>(self) {
+            match self.3 {
+                QuadMethod::Area => area_lanes::<L::V>(self.0, self.1, self.2, self.4),
+                QuadMethod::SolidAngle => {
+                    solid_angle_lanes::<L::V, L::D>(self.0, self.1, self.2, self.4)
+                }
+            }
+        }
+    }
+    simd::run(isa, Records(records, q, active, m.quad, out))
+}
+
 impl Light for QuadLight {
+    fn lane_record(&self, _m: &LightMethods) -> Option<(&'static LaneKernel, [f32; LANE_RECORD])> {
+        let mut r = [0.0; LANE_RECORD];
+        for (k, v) in [self.corner, self.edge_u, self.edge_v, self.normal]
+            .iter()
+            .enumerate()
+        {
+            r[3 * k..3 * k + 3].copy_from_slice(&v.to_array());
+        }
+        r[12] = self.area;
+        r[13..16].copy_from_slice(&self.radiance.to_array());
+        Some((&QUAD_LANES, r))
+    }
+
     fn shape(&self) -> LightShape {
         LightShape::Quad
     }
