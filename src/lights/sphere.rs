@@ -377,23 +377,15 @@ impl Light for SphereLight {
 
 /// Where [`cone_lanes`] reads its spheres: one sphere for every lane (constants), or each
 /// lane's own (rows of records). Read where used, as f32 lanes or exactly as f64 lanes.
-trait SphereLanes<V: Vector<WIDTH>, D: Vector64<WIDTH>> {
-    fn center_d(&self, k: usize) -> D;
-    fn radius_d(&self) -> D;
+trait SphereLanes<V: Vector<WIDTH>> {
     fn center(&self) -> V3<V>;
     fn radius(&self) -> V;
     fn radiance(&self) -> V3<V>;
+    fn center_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
+    fn radius_d<D: Vector64<WIDTH>>(&self) -> D;
 }
 
-impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for SphereLight {
-    #[inline(always)]
-    fn center_d(&self, k: usize) -> D {
-        D::splat(self.center[k] as f64)
-    }
-    #[inline(always)]
-    fn radius_d(&self) -> D {
-        D::splat(self.radius as f64)
-    }
+impl<V: Vector<WIDTH>> SphereLanes<V> for SphereLight {
     #[inline(always)]
     fn center(&self) -> V3<V> {
         V3::splat(self.center)
@@ -406,18 +398,18 @@ impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for SphereLight {
     fn radiance(&self) -> V3<V> {
         V3::splat(self.radiance)
     }
+    #[inline(always)]
+    fn center_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        self.center.as_dvec3().to_array().map(D::splat)
+    }
+    #[inline(always)]
+    fn radius_d<D: Vector64<WIDTH>>(&self) -> D {
+        D::splat(self.radius as f64)
+    }
 }
 
 /// A sphere record's fields: centre (0..3), radius (3), radiance (4..7).
-impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for LaneRecords {
-    #[inline(always)]
-    fn center_d(&self, k: usize) -> D {
-        D::from_f32(&self[k])
-    }
-    #[inline(always)]
-    fn radius_d(&self) -> D {
-        D::from_f32(&self[3])
-    }
+impl<V: Vector<WIDTH>> SphereLanes<V> for LaneRecords {
     #[inline(always)]
     fn center(&self) -> V3<V> {
         V3 {
@@ -438,6 +430,18 @@ impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for LaneRecords {
             z: V::load(&self[6]),
         }
     }
+    #[inline(always)]
+    fn center_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
+        [
+            D::from_f32(&self[0]),
+            D::from_f32(&self[1]),
+            D::from_f32(&self[2]),
+        ]
+    }
+    #[inline(always)]
+    fn radius_d<D: Vector64<WIDTH>>(&self) -> D {
+        D::from_f32(&self[3])
+    }
 }
 
 /// [`SphereLight::sample_cone`] of each lane's sphere for the lanes of `a` whose point is
@@ -446,18 +450,19 @@ impl<V: Vector<WIDTH>, D: Vector64<WIDTH>> SphereLanes<V, D> for LaneRecords {
 /// time. Other lanes of `out` are kept.
 #[inline(always)]
 fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-    s: &impl SphereLanes<V, D>,
+    s: &impl SphereLanes<V>,
     q: &LaneQuery,
     a: u32,
     out: &mut LaneSamples,
 ) -> u32 {
-    let r = s.radius_d();
+    let r = s.radius_d::<D>();
     let r2 = r.mul(r);
     // cone_extent
+    let c = s.center_d::<D>();
     let to_c = [
-        s.center_d(0).sub(D::from_f32(&q.p.x)),
-        s.center_d(1).sub(D::from_f32(&q.p.y)),
-        s.center_d(2).sub(D::from_f32(&q.p.z)),
+        c[0].sub(D::from_f32(&q.p.x)),
+        c[1].sub(D::from_f32(&q.p.y)),
+        c[2].sub(D::from_f32(&q.p.z)),
     ];
     let d2 = to_c[0]
         .mul(to_c[0])
