@@ -35,28 +35,10 @@ const SCENES: [&str; 8] = [
     "ggx_gold_bunny",
 ];
 
-/// A floor under a rectangle light whose edges have no zero component, so every lane
+/// [`FLOOR`] under a rectangle light whose edges have no zero component, so every lane
 /// operation's rounding shows (the built-in quads are axis-aligned or tilted about one axis),
 /// beside a point light, so that MIS meets delta lights and area lights in one packet.
 const TILTED: &str = r#"
-[camera]
-eye = [0.3, 1.2, 4.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y_deg = 50.0
-[image]
-width = 32
-height = 32
-[[material]]
-name = "floor"
-albedo = [0.6, 0.5, 0.4]
-[[material]]
-name = "lamp"
-albedo = [0.0, 0.0, 0.0]
-[[quad]]
-corner = [-2.0, 0.0, -2.0]
-edge_u = [0.0, 0.0, 4.0]
-edge_v = [4.0, 0.0, 0.0]
-material = "floor"
 [[quad]]
 corner = [-0.3, 1.5, 0.1]
 edge_u = [0.4, 0.2, 0.4]
@@ -68,10 +50,9 @@ position = [0.7, 1.1, 0.4]
 power = [4.0, 4.0, 4.0]
 "#;
 
-/// Sphere lights of different centres, radii and radiances over a floor, one of them
-/// enclosing the whole scene: packets whose lanes chose different spheres (each lane's own
-/// sphere in the cone kernel's records), some lanes inside their sphere.
-const SPHERES: &str = r#"
+/// A floor seen from above, and a black material for emitters: what [`TILTED`], [`SPHERES`]
+/// and [`ONE_TRIANGLE`] light.
+const FLOOR: &str = r#"
 [camera]
 eye = [0.2, 1.4, 3.5]
 look_at = [0.0, 0.2, 0.0]
@@ -90,6 +71,12 @@ corner = [-2.0, 0.0, -2.0]
 edge_u = [0.0, 0.0, 4.0]
 edge_v = [4.0, 0.0, 0.0]
 material = "floor"
+"#;
+
+/// Sphere lights of different centres, radii and radiances over a floor, one of them
+/// enclosing the whole scene, over [`FLOOR`]: packets whose lanes chose different spheres
+/// (each lane's own sphere in the cone kernel's records), some lanes inside their sphere.
+const SPHERES: &str = r#"
 [[sphere]]
 center = [-0.6, 0.9, 0.1]
 radius = 0.13
@@ -112,27 +99,9 @@ material = "lamp"
 emission = [0.05, 0.05, 0.05]
 "#;
 
-/// One emitting triangle (facing down, tilted) over a floor: the only light, so every lane
+/// One emitting triangle (facing down, tilted) over [`FLOOR`]: the only light, so every lane
 /// holds it and it samples them itself.
 const ONE_TRIANGLE: &str = r#"
-[camera]
-eye = [0.2, 1.4, 3.5]
-look_at = [0.0, 0.2, 0.0]
-fov_y_deg = 55.0
-[image]
-width = 32
-height = 32
-[[material]]
-name = "floor"
-albedo = [0.6, 0.5, 0.4]
-[[material]]
-name = "lamp"
-albedo = [0.0, 0.0, 0.0]
-[[quad]]
-corner = [-2.0, 0.0, -2.0]
-edge_u = [0.0, 0.0, 4.0]
-edge_v = [4.0, 0.0, 0.0]
-material = "floor"
 [[mesh]]
 file = "triangle.obj"
 material = "lamp"
@@ -151,16 +120,24 @@ fn scenes() -> Vec<(String, PreparedScene)> {
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();
-    let scene = Scene::parse(TILTED, &dir.path().join("tilted.toml")).unwrap();
+    let scene = Scene::parse(&format!("{FLOOR}{TILTED}"), &dir.path().join("tilted.toml")).unwrap();
     v.push(("tilted".into(), PreparedScene::new(scene)));
-    let scene = Scene::parse(SPHERES, &dir.path().join("spheres.toml")).unwrap();
+    let scene = Scene::parse(
+        &format!("{FLOOR}{SPHERES}"),
+        &dir.path().join("spheres.toml"),
+    )
+    .unwrap();
     v.push(("spheres".into(), PreparedScene::new(scene)));
     std::fs::write(
         dir.path().join("triangle.obj"),
         "v -0.4 1.3 0.2\nv 0.5 1.1 -0.3\nv 0.1 1.5 0.6\nf 1 2 3\n",
     )
     .unwrap();
-    let scene = Scene::parse(ONE_TRIANGLE, &dir.path().join("one_triangle.toml")).unwrap();
+    let scene = Scene::parse(
+        &format!("{FLOOR}{ONE_TRIANGLE}"),
+        &dir.path().join("one_triangle.toml"),
+    )
+    .unwrap();
     v.push(("one_triangle".into(), PreparedScene::new(scene)));
     v
 }

@@ -10,7 +10,7 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
-    LightMethods, LightSample, LightShape, MeshMethod, direction_to,
+    LightMethods, LightSample, LightShape, MeshMethod, direction_to, record_rows,
 };
 use crate::geometry::triangle::Triangle;
 use crate::math::gamma;
@@ -170,11 +170,7 @@ fn sample_area_lanes(
 /// [`TriangleLight::sample_area`] for each lane's triangle, bit for bit.
 #[inline(always)]
 fn area_lanes<V: Vector<WIDTH>>(r: &LaneRecords, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
-    let v3 = |k: usize| V3 {
-        x: V::load(&r[k]),
-        y: V::load(&r[k + 1]),
-        z: V::load(&r[k + 2]),
-    };
+    let v3 = |k: usize| record_rows::<V>(r, k);
     let (b1, b2) = uniform_triangle(V::load(&q.u[0]), V::load(&q.u[1]));
     let (point, error) = Triangle::point_lanes([v3(0), v3(3), v3(6)], b1, b2);
     let normal = v3(9);

@@ -381,6 +381,26 @@ pub const LANE_RECORD: usize = 16;
 /// Records of 16 lanes' lights, `records[k][lane]`: field k of lane `lane`'s light.
 pub type LaneRecords = [[f32; WIDTH]; LANE_RECORD];
 
+/// Rows `k..k + 3` of a record as f32 lanes.
+#[inline(always)]
+pub(crate) fn record_rows<V: Vector<WIDTH>>(r: &LaneRecords, k: usize) -> V3<V> {
+    V3 {
+        x: V::load(&r[k]),
+        y: V::load(&r[k + 1]),
+        z: V::load(&r[k + 2]),
+    }
+}
+
+/// Rows `k..k + 3` of a record, exactly, as f64 lanes.
+#[inline(always)]
+pub(crate) fn record_rows_d<D: Vector64<WIDTH>>(r: &LaneRecords, k: usize) -> [D; 3] {
+    [
+        D::from_f32(&r[k]),
+        D::from_f32(&r[k + 1]),
+        D::from_f32(&r[k + 2]),
+    ]
+}
+
 /// A kernel that samples the lanes of a packet together although each lane has its own light
 /// of one type (mesh triangles: every lane picks its own triangle, so sampling per light,
 /// [`Light::sample_lanes`], would run one lane at a time). Each light hands over its

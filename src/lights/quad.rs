@@ -6,6 +6,7 @@ use super::bounds::{Bounds, LightBounds};
 use super::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
     LightMethods, LightSample, LightShape, QuadMethod, SurfaceLanes, d64, direction_to, f32s, keep,
+    record_rows, record_rows_d,
 };
 use crate::math::gamma;
 use crate::math::luminance;
@@ -238,42 +239,22 @@ impl<V: Vector<WIDTH>> QuadLanes<V> for QuadLight {
     }
 }
 
-/// Rows `k..k + 3` of a record as f32 lanes.
-#[inline(always)]
-fn rows<V: Vector<WIDTH>>(r: &LaneRecords, k: usize) -> V3<V> {
-    V3 {
-        x: V::load(&r[k]),
-        y: V::load(&r[k + 1]),
-        z: V::load(&r[k + 2]),
-    }
-}
-
-/// Rows `k..k + 3` of a record, exactly, as f64 lanes.
-#[inline(always)]
-fn rows_d<D: Vector64<WIDTH>>(r: &LaneRecords, k: usize) -> [D; 3] {
-    [
-        D::from_f32(&r[k]),
-        D::from_f32(&r[k + 1]),
-        D::from_f32(&r[k + 2]),
-    ]
-}
-
 impl<V: Vector<WIDTH>> QuadLanes<V> for LaneRecords {
     #[inline(always)]
     fn corner(&self) -> V3<V> {
-        rows(self, 0)
+        record_rows(self, 0)
     }
     #[inline(always)]
     fn edge_u(&self) -> V3<V> {
-        rows(self, 3)
+        record_rows(self, 3)
     }
     #[inline(always)]
     fn edge_v(&self) -> V3<V> {
-        rows(self, 6)
+        record_rows(self, 6)
     }
     #[inline(always)]
     fn normal(&self) -> V3<V> {
-        rows(self, 9)
+        record_rows(self, 9)
     }
     #[inline(always)]
     fn area(&self) -> V {
@@ -281,19 +262,19 @@ impl<V: Vector<WIDTH>> QuadLanes<V> for LaneRecords {
     }
     #[inline(always)]
     fn radiance(&self) -> V3<V> {
-        rows(self, 13)
+        record_rows(self, 13)
     }
     #[inline(always)]
     fn edge_u_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
-        rows_d(self, 3)
+        record_rows_d(self, 3)
     }
     #[inline(always)]
     fn edge_v_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
-        rows_d(self, 6)
+        record_rows_d(self, 6)
     }
     #[inline(always)]
     fn normal_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
-        rows_d(self, 9)
+        record_rows_d(self, 9)
     }
 }
 

@@ -8,7 +8,7 @@ use super::bounds::{Bounds, LightBounds};
 use super::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
     LightMethods, LightSample, LightShape, SphereMethod, d64, direction_to, f32s, keep,
-    sample_lane_by_lane,
+    record_rows, record_rows_d, sample_lane_by_lane,
 };
 use crate::math::{Frame, gamma, luminance};
 use crate::sampling::warp::{
@@ -412,11 +412,7 @@ impl<V: Vector<WIDTH>> SphereLanes<V> for SphereLight {
 impl<V: Vector<WIDTH>> SphereLanes<V> for LaneRecords {
     #[inline(always)]
     fn center(&self) -> V3<V> {
-        V3 {
-            x: V::load(&self[0]),
-            y: V::load(&self[1]),
-            z: V::load(&self[2]),
-        }
+        record_rows(self, 0)
     }
     #[inline(always)]
     fn radius(&self) -> V {
@@ -424,19 +420,11 @@ impl<V: Vector<WIDTH>> SphereLanes<V> for LaneRecords {
     }
     #[inline(always)]
     fn radiance(&self) -> V3<V> {
-        V3 {
-            x: V::load(&self[4]),
-            y: V::load(&self[5]),
-            z: V::load(&self[6]),
-        }
+        record_rows(self, 4)
     }
     #[inline(always)]
     fn center_d<D: Vector64<WIDTH>>(&self) -> [D; 3] {
-        [
-            D::from_f32(&self[0]),
-            D::from_f32(&self[1]),
-            D::from_f32(&self[2]),
-        ]
+        record_rows_d(self, 0)
     }
     #[inline(always)]
     fn radius_d<D: Vector64<WIDTH>>(&self) -> D {
