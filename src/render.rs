@@ -356,9 +356,10 @@ impl<'a> Renderer<'a> {
     /// What the emission rays `mask` of `emit` see that can add radiance: the lanes whose
     /// closest hit is an emitter (`found`, their hits in `hits`) and, where the scene has an
     /// environment, the lanes that hit nothing (`escaped`, no hit in `hits`); other lanes of
-    /// `hits` are not to be read. A ray whose closest hit is an emitter meets an emitter, so the emitters' own
-    /// tracer first tells which rays meet one at all (an occlusion query of a tree of a few
-    /// primitives); only those ask the scene for their closest hit. The others can only
+    /// `hits` are not to be read. A ray whose closest hit is an emitter meets an emitter, so
+    /// the emitters' own tracer first tells which rays meet one at all (an occlusion query of
+    /// a tree of a few primitives); only those ask the scene for their closest hit. The others
+    /// can only
     /// escape: with an environment the scene is asked whether anything lies on them (an
     /// occlusion query, which stops at its first hit), and without one they are done. The
     /// same answers as a closest-hit query of every lane, ties included, with any backend:

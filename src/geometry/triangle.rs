@@ -288,9 +288,7 @@ impl Triangle {
         let t = (ts / det.abs()) as f32;
         (t > 0.0).then_some(t)
     }
-}
 
-impl Triangle {
     /// Whether the triangle lies in a plane `x_k = c` of an axis that also holds the ray's
     /// origin. Then [`Self::t_f64`] finds no hit, exactly: a ray leaving the plane meets it
     /// at t = 0 only, and a ray lying in it (`d_k = 0`, so k is not the dominant axis and its

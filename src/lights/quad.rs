@@ -62,13 +62,6 @@ impl QuadLight {
         })
     }
 
-    /// [`Self::sample_area`] for the lanes of `a` (u = `q.u[0..2]`), the same operations
-    /// in the same order over lanes; other lanes of `out` are kept.
-    #[inline(always)]
-    fn sample_area_lanes<V: Vector<WIDTH>>(&self, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
-        area_lanes::<V>(self, q, a, out)
-    }
-
     /// Solid-angle pdf of [`Self::sample_area`] for the direction that reaches light point q.
     pub fn pdf_area(&self, p: Vec3, q: Vec3) -> f32 {
         let d = q - p;
@@ -126,18 +119,6 @@ impl QuadLight {
         })
     }
 
-    /// [`Self::sample_solid_angle`] for the lanes of `a` (u = `q.u[0..2]`), bit for bit; other
-    /// lanes of `out` are kept.
-    #[inline(always)]
-    fn sample_solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-        &self,
-        q: &LaneQuery,
-        a: u32,
-        out: &mut LaneSamples,
-    ) {
-        solid_angle_lanes::<V, D>(self, q, a, out)
-    }
-
     /// [`Self::pdf_area`] of every lane of `at`, the same operations in the same order (lanes
     /// whose point is their viewpoint, which no hit is, hold values that mean nothing).
     #[inline(always)]
@@ -188,41 +169,41 @@ impl QuadLight {
 /// Where the lane kernels read their quads: one quad for every lane (constants), or each
 /// lane's own (rows of a record: corner 0..3, edge_u 3..6, edge_v 6..9, normal 9..12, area 12,
 /// radiance 13..16). Read where used, as f32 lanes or exactly as f64 lanes.
-trait QuadLanes<V: Vector<WIDTH>> {
-    fn corner(&self) -> V3<V>;
-    fn edge_u(&self) -> V3<V>;
-    fn edge_v(&self) -> V3<V>;
-    fn normal(&self) -> V3<V>;
-    fn area(&self) -> V;
-    fn radiance(&self) -> V3<V>;
+trait QuadLanes {
+    fn corner<V: Vector<WIDTH>>(&self) -> V3<V>;
+    fn edge_u<V: Vector<WIDTH>>(&self) -> V3<V>;
+    fn edge_v<V: Vector<WIDTH>>(&self) -> V3<V>;
+    fn normal<V: Vector<WIDTH>>(&self) -> V3<V>;
+    fn area<V: Vector<WIDTH>>(&self) -> V;
+    fn radiance<V: Vector<WIDTH>>(&self) -> V3<V>;
     fn edge_u_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
     fn edge_v_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
     fn normal_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
 }
 
-impl<V: Vector<WIDTH>> QuadLanes<V> for QuadLight {
+impl QuadLanes for QuadLight {
     #[inline(always)]
-    fn corner(&self) -> V3<V> {
+    fn corner<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.corner)
     }
     #[inline(always)]
-    fn edge_u(&self) -> V3<V> {
+    fn edge_u<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.edge_u)
     }
     #[inline(always)]
-    fn edge_v(&self) -> V3<V> {
+    fn edge_v<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.edge_v)
     }
     #[inline(always)]
-    fn normal(&self) -> V3<V> {
+    fn normal<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.normal)
     }
     #[inline(always)]
-    fn area(&self) -> V {
+    fn area<V: Vector<WIDTH>>(&self) -> V {
         V::splat(self.area)
     }
     #[inline(always)]
-    fn radiance(&self) -> V3<V> {
+    fn radiance<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.radiance)
     }
     #[inline(always)]
@@ -239,29 +220,29 @@ impl<V: Vector<WIDTH>> QuadLanes<V> for QuadLight {
     }
 }
 
-impl<V: Vector<WIDTH>> QuadLanes<V> for LaneRecords {
+impl QuadLanes for LaneRecords {
     #[inline(always)]
-    fn corner(&self) -> V3<V> {
+    fn corner<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 0)
     }
     #[inline(always)]
-    fn edge_u(&self) -> V3<V> {
+    fn edge_u<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 3)
     }
     #[inline(always)]
-    fn edge_v(&self) -> V3<V> {
+    fn edge_v<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 6)
     }
     #[inline(always)]
-    fn normal(&self) -> V3<V> {
+    fn normal<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 9)
     }
     #[inline(always)]
-    fn area(&self) -> V {
+    fn area<V: Vector<WIDTH>>(&self) -> V {
         V::load(&self[12])
     }
     #[inline(always)]
-    fn radiance(&self) -> V3<V> {
+    fn radiance<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 13)
     }
     #[inline(always)]
@@ -281,30 +262,25 @@ impl<V: Vector<WIDTH>> QuadLanes<V> for LaneRecords {
 /// [`QuadLight::sample_area`] of each lane's quad for the lanes of `a` (u = `q.u[0..2]`), the
 /// same operations in the same order over lanes; other lanes of `out` are kept.
 #[inline(always)]
-fn area_lanes<V: Vector<WIDTH>>(
-    s: &impl QuadLanes<V>,
-    q: &LaneQuery,
-    a: u32,
-    out: &mut LaneSamples,
-) {
+fn area_lanes<V: Vector<WIDTH>>(s: &impl QuadLanes, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
     let zero = V::splat(0.0);
     let (u0, u1) = (V::load(&q.u[0]), V::load(&q.u[1]));
-    let eu = s.edge_u().scale(u0);
-    let ev = s.edge_v().scale(u1);
-    let point = s.corner() + eu + ev;
+    let eu = s.edge_u::<V>().scale(u0);
+    let ev = s.edge_v::<V>().scale(u1);
+    let point = s.corner::<V>() + eu + ev;
     // direction_to
     let d = point - V3::load(&q.p);
     let d2 = d.dot(d);
     let wi = d / d2.sqrt();
-    let cos_l = s.normal().dot(wi).neg();
+    let cos_l = s.normal::<V>().dot(wi).neg();
     let valid = a & zero.lt(d2) & !cos_l.le(zero);
-    let error = (s.corner().abs() + eu.abs() + ev.abs()).scale(V::splat(gamma(6)));
-    let pdf = d2.div(s.area().mul(cos_l));
+    let error = (s.corner::<V>().abs() + eu.abs() + ev.abs()).scale(V::splat(gamma(6)));
+    let pdf = d2.div(s.area::<V>().mul(cos_l));
     keep(a, wi, &mut out.wi);
     keep(a, point, &mut out.point);
-    keep(a, s.normal(), &mut out.normal);
+    keep(a, s.normal::<V>(), &mut out.normal);
     keep(a, error, &mut out.point_error);
-    keep(a, s.radiance(), &mut out.radiance);
+    keep(a, s.radiance::<V>(), &mut out.radiance);
     V::select(a, pdf, V::load(&out.pdf)).store(&mut out.pdf);
     out.valid = (out.valid & !a) | valid;
     out.distant &= !a;
@@ -315,7 +291,7 @@ fn area_lanes<V: Vector<WIDTH>>(
 /// ([`area_lanes`]) for the lanes that fall back to it; other lanes of `out` are kept.
 #[inline(always)]
 fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-    s: &impl QuadLanes<V>,
+    s: &impl QuadLanes,
     q: &LaneQuery,
     a: u32,
     out: &mut LaneSamples,
@@ -339,9 +315,9 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     let pdf = f32s::<V, D>(D::splat(1.0).div(rect.area()));
     keep(solid, wi, &mut out.wi);
     keep(solid, point, &mut out.point);
-    keep(solid, s.normal(), &mut out.normal);
+    keep(solid, s.normal::<V>(), &mut out.normal);
     keep(solid, error, &mut out.point_error);
-    keep(solid, s.radiance(), &mut out.radiance);
+    keep(solid, s.radiance::<V>(), &mut out.radiance);
     V::select(solid, pdf, V::load(&out.pdf)).store(&mut out.pdf);
     // Lanes behind the light have no sample; tiny rectangles are sampled by area.
     out.valid = (out.valid & !(a & !faces)) | solid;
@@ -355,12 +331,12 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
 /// hold finite values that mean nothing.
 #[inline(always)]
 fn rect_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-    s: &impl QuadLanes<V>,
+    s: &impl QuadLanes,
     p: V3<V>,
     a: u32,
 ) -> (SphericalRectangle<D>, u32, u32) {
-    let corner32 = s.corner();
-    let faces = a & V::splat(0.0).lt((p - corner32).dot(s.normal()));
+    let corner32 = s.corner::<V>();
+    let faces = a & V::splat(0.0).lt((p - corner32).dot(s.normal::<V>()));
     // The corner relative to p, rounded in f32 and then widened.
     let rel = corner32 - p;
     let corner = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
@@ -387,26 +363,23 @@ fn sample_quad_records(
     m: &LightMethods,
     out: &mut LaneSamples,
 ) {
-    struct Records<'a>(
-        &'a LaneRecords,
-        &'a LaneQuery,
-        u32,
-        QuadMethod,
-        &'a mut LaneSamples,
-    );
-    impl Kernel for Records<'_> {
-        type Out = ();
-        #[inline(always)]
-        fn run<L: Lanes>(self) {
-            match self.3 {
-                QuadMethod::Area => area_lanes::<L::V>(self.0, self.1, self.2, self.4),
-                QuadMethod::SolidAngle => {
-                    solid_angle_lanes::<L::V, L::D>(self.0, self.1, self.2, self.4)
-                }
+    simd::run(isa, QuadKernel(records, q, active, m.quad, out))
+}
+
+/// Samples lanes `.2` of `.1` by method `.3` from quads `.0` (constants or records).
+struct QuadKernel<'a, S>(&'a S, &'a LaneQuery, u32, QuadMethod, &'a mut LaneSamples);
+
+impl<S: QuadLanes> Kernel for QuadKernel<'_, S> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        match self.3 {
+            QuadMethod::Area => area_lanes::<L::V>(self.0, self.1, self.2, self.4),
+            QuadMethod::SolidAngle => {
+                solid_angle_lanes::<L::V, L::D>(self.0, self.1, self.2, self.4)
             }
         }
     }
-    simd::run(isa, Records(records, q, active, m.quad, out))
 }
 
 impl Light for QuadLight {
@@ -456,27 +429,7 @@ impl Light for QuadLight {
         m: &LightMethods,
         out: &mut LaneSamples,
     ) {
-        struct Area<'a>(&'a QuadLight, &'a LaneQuery, u32, &'a mut LaneSamples);
-        impl Kernel for Area<'_> {
-            type Out = ();
-            #[inline(always)]
-            fn run<L: Lanes>(self) {
-                self.0.sample_area_lanes::<L::V>(self.1, self.2, self.3)
-            }
-        }
-        struct SolidAngle<'a>(&'a QuadLight, &'a LaneQuery, u32, &'a mut LaneSamples);
-        impl Kernel for SolidAngle<'_> {
-            type Out = ();
-            #[inline(always)]
-            fn run<L: Lanes>(self) {
-                self.0
-                    .sample_solid_angle_lanes::<L::V, L::D>(self.1, self.2, self.3)
-            }
-        }
-        match m.quad {
-            QuadMethod::Area => simd::run(isa, Area(self, q, active, out)),
-            QuadMethod::SolidAngle => simd::run(isa, SolidAngle(self, q, active, out)),
-        }
+        simd::run(isa, QuadKernel(self, q, active, m.quad, out))
     }
 
     fn pdf(&self, ctx: &LightCtx, at: LightHit, m: &LightMethods) -> f32 {

@@ -83,19 +83,6 @@ impl SphereLight {
         })
     }
 
-    /// [`Self::sample_cone`] for the lanes of `a` whose point is outside the sphere, over lanes,
-    /// the same operations in the same order (the f64 parts in f64 lanes); returns the lanes
-    /// of `a` inside it, which the caller samples one at a time. Other lanes of `out` are kept.
-    #[inline(always)]
-    fn sample_cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-        &self,
-        q: &LaneQuery,
-        a: u32,
-        out: &mut LaneSamples,
-    ) -> u32 {
-        cone_lanes::<V, D>(self, q, a, out)
-    }
-
     /// Solid-angle pdf of [`Self::sample_cone`] for the direction from p to the light point q.
     pub fn pdf_cone(&self, p: Vec3, q: Vec3) -> f32 {
         let to_c = self.center - p;
@@ -345,16 +332,7 @@ impl Light for SphereLight {
         if m.sphere != SphereMethod::Cone {
             return sample_lane_by_lane(self, q, active, m, out);
         }
-        struct Cone<'a>(&'a SphereLight, &'a LaneQuery, u32, &'a mut LaneSamples);
-        impl Kernel for Cone<'_> {
-            type Out = u32;
-            #[inline(always)]
-            fn run<L: Lanes>(self) -> u32 {
-                self.0
-                    .sample_cone_lanes::<L::V, L::D>(self.1, self.2, self.3)
-            }
-        }
-        let inside = simd::run(isa, Cone(self, q, active, out));
+        let inside = simd::run(isa, ConeKernel(self, q, active, out));
         sample_lane_by_lane(self, q, inside, m, out);
     }
 
@@ -377,25 +355,25 @@ impl Light for SphereLight {
 
 /// Where [`cone_lanes`] reads its spheres: one sphere for every lane (constants), or each
 /// lane's own (rows of records). Read where used, as f32 lanes or exactly as f64 lanes.
-trait SphereLanes<V: Vector<WIDTH>> {
-    fn center(&self) -> V3<V>;
-    fn radius(&self) -> V;
-    fn radiance(&self) -> V3<V>;
+trait SphereLanes {
+    fn center<V: Vector<WIDTH>>(&self) -> V3<V>;
+    fn radius<V: Vector<WIDTH>>(&self) -> V;
+    fn radiance<V: Vector<WIDTH>>(&self) -> V3<V>;
     fn center_d<D: Vector64<WIDTH>>(&self) -> [D; 3];
     fn radius_d<D: Vector64<WIDTH>>(&self) -> D;
 }
 
-impl<V: Vector<WIDTH>> SphereLanes<V> for SphereLight {
+impl SphereLanes for SphereLight {
     #[inline(always)]
-    fn center(&self) -> V3<V> {
+    fn center<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.center)
     }
     #[inline(always)]
-    fn radius(&self) -> V {
+    fn radius<V: Vector<WIDTH>>(&self) -> V {
         V::splat(self.radius)
     }
     #[inline(always)]
-    fn radiance(&self) -> V3<V> {
+    fn radiance<V: Vector<WIDTH>>(&self) -> V3<V> {
         V3::splat(self.radiance)
     }
     #[inline(always)]
@@ -409,17 +387,17 @@ impl<V: Vector<WIDTH>> SphereLanes<V> for SphereLight {
 }
 
 /// A sphere record's fields: centre (0..3), radius (3), radiance (4..7).
-impl<V: Vector<WIDTH>> SphereLanes<V> for LaneRecords {
+impl SphereLanes for LaneRecords {
     #[inline(always)]
-    fn center(&self) -> V3<V> {
+    fn center<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 0)
     }
     #[inline(always)]
-    fn radius(&self) -> V {
+    fn radius<V: Vector<WIDTH>>(&self) -> V {
         V::load(&self[3])
     }
     #[inline(always)]
-    fn radiance(&self) -> V3<V> {
+    fn radiance<V: Vector<WIDTH>>(&self) -> V3<V> {
         record_rows(self, 4)
     }
     #[inline(always)]
@@ -438,7 +416,7 @@ impl<V: Vector<WIDTH>> SphereLanes<V> for LaneRecords {
 /// time. Other lanes of `out` are kept.
 #[inline(always)]
 fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-    s: &impl SphereLanes<V>,
+    s: &impl SphereLanes,
     q: &LaneQuery,
     a: u32,
     out: &mut LaneSamples,
@@ -493,8 +471,8 @@ fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     );
     // Frame::to_world in glam's order.
     let normal = fs.scale(nx) + ft.scale(ny) + axis.scale(nz);
-    let centre = s.center();
-    let point = centre + normal.scale(s.radius());
+    let centre = s.center::<V>();
+    let point = centre + normal.scale(s.radius::<V>());
     let wi = fs.scale(lx32) + ft.scale(ly32) + axis.scale(lz32);
     // Sphere::point_error
     let error =
@@ -504,7 +482,7 @@ fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     keep(outside, point, &mut out.point);
     keep(outside, normal, &mut out.normal);
     keep(outside, error, &mut out.point_error);
-    keep(outside, s.radiance(), &mut out.radiance);
+    keep(outside, s.radiance::<V>(), &mut out.radiance);
     V::select(outside, pdf, V::load(&out.pdf)).store(&mut out.pdf);
     out.valid |= outside;
     out.distant &= !outside;
@@ -526,15 +504,7 @@ fn sample_cone_records(
     m: &LightMethods,
     out: &mut LaneSamples,
 ) {
-    struct Cone<'a>(&'a LaneRecords, &'a LaneQuery, u32, &'a mut LaneSamples);
-    impl Kernel for Cone<'_> {
-        type Out = u32;
-        #[inline(always)]
-        fn run<L: Lanes>(self) -> u32 {
-            cone_lanes::<L::V, L::D>(self.0, self.1, self.2, self.3)
-        }
-    }
-    let mut inside = simd::run(isa, Cone(records, q, active, out));
+    let mut inside = simd::run(isa, ConeKernel(records, q, active, out));
     while inside != 0 {
         let lane = inside.trailing_zeros() as usize;
         inside &= inside - 1;
@@ -545,6 +515,18 @@ fn sample_cone_records(
             radiance: Vec3::new(f(4), f(5), f(6)),
         };
         sample_lane_by_lane(&sphere, q, 1 << lane, m, out);
+    }
+}
+
+/// Cone samples of lanes `.2` of `.1` from spheres `.0` (constants or records); returns the
+/// lanes inside their sphere, which the caller samples one at a time.
+struct ConeKernel<'a, S>(&'a S, &'a LaneQuery, u32, &'a mut LaneSamples);
+
+impl<S: SphereLanes> Kernel for ConeKernel<'_, S> {
+    type Out = u32;
+    #[inline(always)]
+    fn run<L: Lanes>(self) -> u32 {
+        cone_lanes::<L::V, L::D>(self.0, self.1, self.2, self.3)
     }
 }
 

@@ -451,7 +451,7 @@ impl<'s> BoundLights<'s> {
             }
             chosen = c;
         }
-        // Lights with a kernel over lanes of different lights (mesh triangles, spheres) hand
+        // Lights with a kernel over lanes of different lights (mesh triangles, spheres, quads) hand
         // over their records; each such kernel samples all its lanes at once. One light for
         // every lane samples them itself below ([`Light::sample_lanes`], its parameters
         // constants).
