@@ -277,8 +277,8 @@ fn light_probes_over_lanes_are_the_scalar_ones() {
                 .map(|o| o.apply(LightMethods::BASIC)),
         );
         if scene.scene.environment.is_some() {
-            // Every representation and sampler (lat/long by hierarchical warping has a
-            // kernel over lanes).
+            // Every representation and sampler (lat/long, by either sampler, has a kernel
+            // over lanes).
             sets.extend(dibench::strategy::env_methods().map(|env| LightMethods {
                 env,
                 ..LightMethods::BASIC

@@ -241,16 +241,41 @@ impl ImportanceMap {
         )
     }
 
+    /// The atlas point (u, v) ∈ [0, 1)² of the texel (col, row) at offsets (du, dv), rounded
+    /// once from f64 to f32.
+    #[inline(always)]
+    fn cdf_uv(t: &TexelMap, col: usize, row: usize, du: f64, dv: f64) -> [f32; 2] {
+        [
+            below_one(((col as f64 + du) / t.width as f64) as f32),
+            below_one(((row as f64 + dv) / t.height as f64) as f32),
+        ]
+    }
+
+    /// The atlas points of N lanes' marginal/conditional samples, in lockstep.
+    #[inline(always)]
+    fn cdf_uv_lanes<V: Vector<N>, const N: usize>(
+        cdf: &MarginalConditional,
+        t: &TexelMap,
+        u0: V,
+        u1: V,
+    ) -> (V, V) {
+        let (mut a, mut b) = ([0.0f32; N], [0.0f32; N]);
+        u0.store(&mut a);
+        u1.store(&mut b);
+        let (col, row, du, dv) = cdf.sample_lanes([a, b]);
+        for i in 0..N {
+            [a[i], b[i]] = Self::cdf_uv(t, col[i], row[i], du[i], dv[i]);
+        }
+        (V::load(&a), V::load(&b))
+    }
+
     /// None for a black map, and for the measure-zero atlas points where J = 0 (lat/long poles).
     pub fn sample(&self, sampler: EnvSampler, u: [f32; 2]) -> Option<EnvSample> {
         let t = &self.texels;
         let uv = match sampler {
             EnvSampler::Cdf => {
                 let ((col, row), [du, dv]) = self.cdf.as_ref()?.sample(u);
-                [
-                    below_one(((col as f64 + du) / t.width as f64) as f32),
-                    below_one(((row as f64 + dv) / t.height as f64) as f32),
-                ]
+                Self::cdf_uv(t, col, row, du, dv)
             }
             EnvSampler::Hierarchical => {
                 let (u, v) = Self::hier_uv::<f32, 1>(self.hier.as_ref()?, t, u[0], u[1]);
@@ -271,12 +296,13 @@ impl ImportanceMap {
         })
     }
 
-    /// [`Self::sample`] by hierarchical warping for the lanes of `active`, over lanes, for the
+    /// [`Self::sample`] by either sampler for the lanes of `active`, over lanes, for the
     /// lat/long representation: lane i is [`Self::sample`] of lane i, bit for bit. None when
     /// this map is not lat/long (its maps are scalar) or black.
     #[inline(always)]
-    pub fn sample_latlong_hier_lanes<V: Vector<WIDTH>>(
+    pub fn sample_latlong_lanes<V: Vector<WIDTH>>(
         &self,
+        sampler: EnvSampler,
         u0: V,
         u1: V,
         active: u32,
@@ -285,7 +311,10 @@ impl ImportanceMap {
         if t.repr != Repr::LatLong {
             return None;
         }
-        let (u, v) = Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, u0, u1);
+        let (u, v) = match sampler {
+            EnvSampler::Cdf => Self::cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, t, u0, u1),
+            EnvSampler::Hierarchical => Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, u0, u1),
+        };
         let k = t.index_lanes::<V, WIDTH>(u, v);
         let jac = latlong::jacobian_lanes(v);
         let (x, y, z) = latlong::uv_to_dir_lanes(u, v);

@@ -60,8 +60,8 @@ impl Light for EnvironmentLight {
         self.sample_env([u[0], u[1]], m.env)
     }
 
-    /// Over lanes for lat/long maps sampled hierarchically (the pair Mitsuba 3's `envmap`
-    /// uses); lane by lane otherwise.
+    /// Over lanes for lat/long maps (by either sampler); lane by lane for the other
+    /// representations, whose maps are scalar.
     fn sample_lanes(
         &self,
         isa: Isa,
@@ -70,20 +70,20 @@ impl Light for EnvironmentLight {
         m: &LightMethods,
         out: &mut LaneSamples,
     ) {
-        if m.env.repr != Repr::LatLong || m.env.sampler != EnvSampler::Hierarchical {
+        if m.env.repr != Repr::LatLong {
             return sample_lane_by_lane(self, q, active, m, out);
         }
-        struct Hier<'a>(&'a ImportanceMap, &'a LaneQuery, u32);
-        impl Kernel for Hier<'_> {
+        struct LatLong<'a>(&'a ImportanceMap, EnvSampler, &'a LaneQuery, u32);
+        impl Kernel for LatLong<'_> {
             type Out = Option<EnvLanes>;
             #[inline(always)]
             fn run<L: Lanes>(self) -> Option<EnvLanes> {
-                let (u0, u1) = (L::V::load(&self.1.u[0]), L::V::load(&self.1.u[1]));
-                self.0.sample_latlong_hier_lanes::<L::V>(u0, u1, self.2)
+                let (u0, u1) = (L::V::load(&self.2.u[0]), L::V::load(&self.2.u[1]));
+                self.0.sample_latlong_lanes::<L::V>(self.1, u0, u1, self.3)
             }
         }
         let map = self.env.map(Repr::LatLong);
-        let Some(s) = simd::run(isa, Hier(map, q, active)) else {
+        let Some(s) = simd::run(isa, LatLong(map, m.env.sampler, q, active)) else {
             out.valid &= !active; // a black map: nothing to sample
             return;
         };
