@@ -13,17 +13,9 @@ pub struct MarginalConditional {
     marginal: Vec<f64>,
 }
 
-/// Index i with cdf[i] ≤ u·total < cdf[i+1], and the offset of u inside that cell, for a
-/// cumulative array starting at 0 with a positive total. Cells of zero width are never chosen.
-pub fn sample_cumulative(cdf: &[f64], u: f64) -> (usize, f64) {
-    let n = cdf.len() - 1;
-    let target = u * cdf[n];
-    let i = cdf[1..].partition_point(|&c| c <= target).min(n - 1);
-    (i, cell_offset(cdf, i, target))
-}
-
-/// [`sample_cumulative`] of N lanes in lockstep, each lane in its own cumulative array of
-/// `len + 1` entries starting at `data[start[i]]`: the same (index, offset) per lane. The
+/// Index i with cdf[i] ≤ u·total < cdf[i+1], and the offset of u inside that cell, for N lanes
+/// in lockstep, each lane in its own cumulative array (starting at 0, with a positive total) of
+/// `len + 1` entries from `data[start[i]]`. Cells of zero width are never chosen. The
 /// search is branchless (Knuth's uniform binary search, in the form of Khuong & Morin,
 /// "Array Layouts for Comparison-Based Searching", 2017, §3): every lane takes the same
 /// ⌈log₂ len⌉ steps, so the lanes' loads overlap instead of each waiting behind the branch
@@ -101,17 +93,15 @@ impl MarginalConditional {
 
     /// (column, row) of the chosen texel and the offsets (du, dv) ∈ [0, 1)² inside it:
     /// u[1] picks the row, u[0] the column.
+    /// Through the lockstep search of one lane ([`Self::sample_lanes`]): as a branch, each
+    /// step of a binary search is mispredicted half the time.
     pub fn sample(&self, u: [f32; 2]) -> ((usize, usize), [f64; 2]) {
-        let (row, dv) = sample_cumulative(&self.marginal, u[1] as f64);
-        let stride = self.width + 1;
-        let cond = &self.conditional[row * stride..(row + 1) * stride];
-        let (col, du) = sample_cumulative(cond, u[0] as f64);
-        ((col, row), [du, dv])
+        let (col, row, du, dv) = self.sample_lanes([[u[0]], [u[1]]]);
+        ((col[0], row[0]), [du[0], dv[0]])
     }
 
     /// [`Self::sample`] of N lanes (u[0] the columns', u[1] the rows'), searched in lockstep
-    /// ([`sample_cumulative_lanes`]): (columns, rows, du, dv), lane i bit for bit the scalar
-    /// sample of lane i.
+    /// ([`sample_cumulative_lanes`]): (columns, rows, du, dv).
     #[inline(always)]
     #[allow(clippy::type_complexity)]
     pub fn sample_lanes<const N: usize>(
@@ -137,12 +127,22 @@ mod tests {
     use super::*;
     use crate::sampling::stream::SampleStream;
 
+    /// Index i with cdf[i] ≤ u·total < cdf[i+1], and the offset of u inside that cell, for a
+    /// cumulative array starting at 0 with a positive total. Cells of zero width are never chosen.
+    /// The definition [`sample_cumulative_lanes`] is tested against.
+    fn sample_cumulative(cdf: &[f64], u: f64) -> (usize, f64) {
+        let n = cdf.len() - 1;
+        let target = u * cdf[n];
+        let i = cdf[1..].partition_point(|&c| c <= target).min(n - 1);
+        (i, cell_offset(cdf, i, target))
+    }
+
     type Search = fn(&[f64], [usize; 8], usize, [f64; 8]) -> ([usize; 8], [f64; 8]);
 
     /// Where `search` of 8 lanes leaves [`sample_cumulative`] lane by lane (index, and offset
-    /// bit for bit), over rows with empty cells at the start, middle and end, and with u on
-    /// the cells' boundaries (the rows' totals are powers of two, so u·total is exact there),
-    /// at 0 and just below 1.
+    /// bit for bit), over rows of 8, 7, 5 and 1 cells with empty cells at the start, middle
+    /// and end, and with u on the cells' boundaries (u = k/16 and sums of few bits, so u·total
+    /// is exact there), at 0 and just below 1.
     fn lanes_mismatch(search: Search) -> Option<String> {
         let rows: [&[f64]; 4] = [
             &[0.0, 0.0, 0.0, 1.0, 3.0, 3.0, 4.0, 4.0, 4.0],
@@ -150,10 +150,12 @@ mod tests {
             &[0.0, 5.0, 5.0, 5.0, 5.0, 5.0, 6.0, 8.0, 8.0],
             &[0.0, 0.5, 0.75, 0.75, 1.5, 1.5, 1.5, 2.0, 2.0],
         ];
-        let (len, data) = (8, rows.concat());
         let mut rng = SampleStream::new(7, 3, 1, 2);
         let below_one = f64::from(crate::sampling::stream::ONE_MINUS_EPSILON);
-        for round in 0..2000 {
+        for round in 0..4000 {
+            // Lengths of a power of two and not (the search halves unevenly), down to one.
+            let len = [8, 7, 5, 1][round % 4];
+            let data: Vec<f64> = rows.iter().flat_map(|r| &r[..=len]).copied().collect();
             let start: [usize; 8] = std::array::from_fn(|i| ((i + round) % 4) * (len + 1));
             let u: [f64; 8] = std::array::from_fn(|i| match (round + i) % 4 {
                 0 => (rng.next_2d()[0] * 16.0).floor() as f64 / 16.0,
