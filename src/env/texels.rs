@@ -254,6 +254,7 @@ impl ImportanceMap {
     /// The atlas points of N lanes' marginal/conditional samples, in lockstep.
     #[inline(always)]
     fn cdf_uv_lanes<V: Vector<N>, const N: usize>(
+        &self,
         cdf: &MarginalConditional,
         t: &TexelMap,
         u0: V,
@@ -263,6 +264,9 @@ impl ImportanceMap {
         u0.store(&mut a);
         u1.store(&mut b);
         let (col, row, du, dv) = cdf.sample_lanes([a, b]);
+        for i in 0..N {
+            crate::simd::prefetch(&self.record[row[i] * t.width + col[i]]);
+        }
         for i in 0..N {
             [a[i], b[i]] = Self::cdf_uv(t, col[i], row[i], du[i], dv[i]);
         }
@@ -312,7 +316,7 @@ impl ImportanceMap {
             return None;
         }
         let (u, v) = match sampler {
-            EnvSampler::Cdf => Self::cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, t, u0, u1),
+            EnvSampler::Cdf => self.cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, t, u0, u1),
             EnvSampler::Hierarchical => Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, u0, u1),
         };
         let k = t.index_lanes::<V, WIDTH>(u, v);
