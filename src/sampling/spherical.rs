@@ -4,92 +4,154 @@
 //! #340). Below [`MIN_SOLID_ANGLE`] callers fall back to area sampling, with the same decision
 //! in sampler and pdf.
 
-use crate::math::{acos64, sin_cos64};
-use crate::simd::{D3, Vector64, cross3, div3, dot3, normalize3, scale3};
+use crate::math::{acos64, asin64, atan2_64_upper, sin_cos64};
+use crate::simd::{
+    D3, Vector64, add3, cross3, div3, dot3, neg3, normalize3, scale3, select3, sub3,
+};
 use glam::DVec3;
 use std::f64::consts::PI;
 
 /// Solid angles below this (sr) are sampled by area instead: f64 resolves them to ~1e-9 relative.
 pub const MIN_SOLID_ANGLE: f64 = 1e-7;
 
-/// Angle between unit vectors, accurate near 0 and π (pbrt-v4 `AngleBetween`).
-fn angle_between(a: DVec3, b: DVec3) -> f64 {
-    if a.dot(b) < 0.0 {
-        PI - 2.0 * ((a + b).length() / 2.0).min(1.0).asin()
-    } else {
-        2.0 * ((b - a).length() / 2.0).min(1.0).asin()
-    }
+/// Angle between unit vectors, accurate near 0 and π (pbrt-v4 `AngleBetween`): by the half
+/// chord, 2·asin(|b − a|/2) or π − 2·asin(|a + b|/2), whichever is the smaller angle's.
+#[inline(always)]
+fn angle_between<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D {
+    let c = D::splat;
+    let obtuse = dot3(a, b).lt(c(0.0));
+    let chord = select3(obtuse, add3(a, b), sub3(b, a));
+    let h = asin64(dot3(chord, chord).sqrt().div(c(2.0)).min(c(1.0)));
+    let two_h = c(2.0).mul(h);
+    D::select(obtuse, c(PI).sub(two_h), two_h)
 }
 
-fn gram_schmidt(v: DVec3, w: DVec3) -> DVec3 {
-    v - v.dot(w) * w
+/// v − (v·w)·w.
+#[inline(always)]
+fn gram_schmidt<D: Vector64<N>, const N: usize>(v: D3<D>, w: D3<D>) -> D3<D> {
+    sub3(v, scale3(w, dot3(v, w)))
 }
 
 /// Solid angle of the spherical triangle with unit vertices a, b, c, by Van Oosterom &
 /// Strackee (1983): Ω = 2·atan2(|a·(b×c)|, 1 + a·b + b·c + c·a). Accurate for tiny triangles.
 pub fn triangle_solid_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    2.0 * a
-        .dot(b.cross(c))
-        .abs()
-        .atan2(1.0 + a.dot(b) + b.dot(c) + c.dot(a))
+    triangle_solid_angle_lanes::<f64, 1>(a.to_array(), b.to_array(), c.to_array())
 }
 
-/// Spherical triangle seen from the origin, vertices as unit vectors.
-pub struct SphericalTriangle {
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
-    alpha: f64,
-    area: f64,
+/// [`triangle_solid_angle`] over lanes.
+#[inline(always)]
+pub fn triangle_solid_angle_lanes<D: Vector64<N>, const N: usize>(
+    a: D3<D>,
+    b: D3<D>,
+    c: D3<D>,
+) -> D {
+    let one = D::splat(1.0);
+    let y = dot3(a, cross3(b, c)).abs();
+    let x = one.add(dot3(a, b)).add(dot3(b, c)).add(dot3(c, a));
+    D::splat(2.0).mul(atan2_64_upper(y, x))
 }
 
-impl SphericalTriangle {
+/// Spherical triangle seen from the origin, vertices as unit vectors, for the lanes of `D`
+/// (`f64`: one triangle). Written once over lanes, trigonometry included ([`asin64`],
+/// [`sin_cos64`]), so sampled over lanes and alone it gives the same bits.
+#[derive(Clone, Copy)]
+pub struct SphericalTriangle<D = f64> {
+    a: D3<D>,
+    b: D3<D>,
+    c: D3<D>,
+    alpha: D,
+    area: D,
+}
+
+impl SphericalTriangle<f64> {
     /// None for degenerate (zero-area) spherical triangles.
     pub fn new(a: DVec3, b: DVec3, c: DVec3) -> Option<Self> {
-        let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
-        if n_ab.length_squared() == 0.0
-            || n_bc.length_squared() == 0.0
-            || n_ca.length_squared() == 0.0
-        {
-            return None;
-        }
-        let (n_ab, n_bc, n_ca) = (n_ab.normalize(), n_bc.normalize(), n_ca.normalize());
-        let alpha = angle_between(n_ab, -n_ca);
-        let beta = angle_between(n_bc, -n_ab);
-        let gamma = angle_between(n_ca, -n_bc);
-        let area = alpha + beta + gamma - PI;
-        (area > 0.0).then_some(SphericalTriangle {
-            a,
-            b,
-            c,
-            alpha,
-            area,
-        })
-    }
-
-    /// The solid angle the sampler is uniform over (Girard: α + β + γ - π).
-    pub fn area(&self) -> f64 {
-        self.area
+        let (t, valid) = Self::lanes(a.to_array(), b.to_array(), c.to_array());
+        (valid != 0).then_some(t)
     }
 
     /// Uniform direction in the triangle (Arvo 1995, in pbrt-v4's formulation): choose the
     /// sub-triangle of area u0·A through vertex a, then a point on its arc b–c'.
     pub fn sample(&self, u: [f64; 2]) -> DVec3 {
+        DVec3::from_array(self.sample_lanes(u[0], u[1]))
+    }
+}
+
+impl<D: Copy> SphericalTriangle<D> {
+    /// [`SphericalTriangle::new`] over lanes: the triangles and the lanes that have one (bit i:
+    /// lane i). Lanes without one hold finite values that mean nothing.
+    #[inline(always)]
+    pub fn lanes<const N: usize>(a: D3<D>, b: D3<D>, c: D3<D>) -> (Self, u32)
+    where
+        D: Vector64<N>,
+    {
+        let k = D::splat;
+        let (n_ab, n_bc, n_ca) = (cross3(a, b), cross3(b, c), cross3(c, a));
+        let zero = k(0.0);
+        let all = (u64::MAX >> (64 - N)) as u32;
+        let mut valid = all
+            & !(dot3(n_ab, n_ab).eq(zero) | dot3(n_bc, n_bc).eq(zero) | dot3(n_ca, n_ca).eq(zero));
+        // Lanes with a vertex on another's great circle take three orthogonal normals instead,
+        // so that nothing below is 0/0.
+        let (o, l) = (k(0.0), k(1.0));
+        let n_ab = normalize3(select3(valid, n_ab, [l, o, o]));
+        let n_bc = normalize3(select3(valid, n_bc, [o, l, o]));
+        let n_ca = normalize3(select3(valid, n_ca, [o, o, l]));
+        let alpha = angle_between(n_ab, neg3(n_ca));
+        let beta = angle_between(n_bc, neg3(n_ab));
+        let gamma = angle_between(n_ca, neg3(n_bc));
+        let area = alpha.add(beta).add(gamma).sub(k(PI));
+        valid &= zero.lt(area);
+        (
+            SphericalTriangle {
+                a,
+                b,
+                c,
+                alpha,
+                area,
+            },
+            valid,
+        )
+    }
+
+    /// The solid angle the sampler is uniform over (Girard: α + β + γ − π).
+    pub fn area(&self) -> D {
+        self.area
+    }
+
+    /// [`SphericalTriangle::sample`] over lanes, for u = (u0, u1).
+    #[inline(always)]
+    pub fn sample_lanes<const N: usize>(&self, u0: D, u1: D) -> D3<D>
+    where
+        D: Vector64<N>,
+    {
+        let k = D::splat;
+        let one = k(1.0);
         let (a, b, c, alpha) = (self.a, self.b, self.c, self.alpha);
-        let ap_pi = u[0] * self.area + PI; // A' + π
-        let (cos_a, sin_a) = (alpha.cos(), alpha.sin());
-        let sin_phi = ap_pi.sin() * cos_a - ap_pi.cos() * sin_a;
-        let cos_phi = ap_pi.cos() * cos_a + ap_pi.sin() * sin_a;
-        let k1 = cos_phi + cos_a;
-        let k2 = sin_phi - sin_a * a.dot(b);
-        let cos_bp = ((k2 + (k2 * cos_phi - k1 * sin_phi) * cos_a)
-            / ((k2 * sin_phi + k1 * cos_phi) * sin_a))
-            .clamp(-1.0, 1.0);
-        let sin_bp = (1.0 - cos_bp * cos_bp).max(0.0).sqrt();
-        let cp = cos_bp * a + sin_bp * gram_schmidt(c, a).normalize();
-        let cos_t = 1.0 - u[1] * (1.0 - cp.dot(b));
-        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-        (cos_t * b + sin_t * gram_schmidt(cp, b).normalize()).normalize()
+        let ap_pi = u0.mul(self.area).add(k(PI)); // A' + π
+        let (sin_a, cos_a) = sin_cos64(alpha);
+        let (sin_ap, cos_ap) = sin_cos64(ap_pi);
+        let sin_phi = sin_ap.mul(cos_a).sub(cos_ap.mul(sin_a));
+        let cos_phi = cos_ap.mul(cos_a).add(sin_ap.mul(sin_a));
+        let k1 = cos_phi.add(cos_a);
+        let k2 = sin_phi.sub(sin_a.mul(dot3(a, b)));
+        let cos_bp = clamp(
+            k2.add(k2.mul(cos_phi).sub(k1.mul(sin_phi)).mul(cos_a))
+                .div(k2.mul(sin_phi).add(k1.mul(cos_phi)).mul(sin_a)),
+            k(-1.0),
+            one,
+        );
+        let sin_bp = one.sub(cos_bp.mul(cos_bp)).max(k(0.0)).sqrt();
+        let cp = add3(
+            scale3(a, cos_bp),
+            scale3(normalize3(gram_schmidt(c, a)), sin_bp),
+        );
+        let cos_t = one.sub(u1.mul(one.sub(dot3(cp, b))));
+        let sin_t = one.sub(cos_t.mul(cos_t)).max(k(0.0)).sqrt();
+        normalize3(add3(
+            scale3(b, cos_t),
+            scale3(normalize3(gram_schmidt(cp, b)), sin_t),
+        ))
     }
 }
 

@@ -16,7 +16,7 @@ mod portable;
 mod vec3;
 
 pub use isa::Isa;
-pub use vec3::{D3, Soa3, V3, cross3, div3, dot3, normalize3, scale3};
+pub use vec3::{D3, Soa3, V3, add3, cross3, div3, dot3, neg3, normalize3, scale3, select3, sub3};
 
 /// Lane count of a packet: one 4×4 pixel tile (see the assertion in `tracer`).
 pub const WIDTH: usize = 16;

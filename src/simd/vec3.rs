@@ -181,3 +181,28 @@ pub fn div3<D: Vector64<N>, const N: usize>(a: D3<D>, s: D) -> D3<D> {
 pub fn normalize3<D: Vector64<N>, const N: usize>(a: D3<D>) -> D3<D> {
     scale3(a, D::splat(1.0).div(dot3(a, a).sqrt()))
 }
+
+#[inline(always)]
+pub fn add3<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D3<D> {
+    [a[0].add(b[0]), a[1].add(b[1]), a[2].add(b[2])]
+}
+
+#[inline(always)]
+pub fn sub3<D: Vector64<N>, const N: usize>(a: D3<D>, b: D3<D>) -> D3<D> {
+    [a[0].sub(b[0]), a[1].sub(b[1]), a[2].sub(b[2])]
+}
+
+#[inline(always)]
+pub fn neg3<D: Vector64<N>, const N: usize>(a: D3<D>) -> D3<D> {
+    [a[0].neg(), a[1].neg(), a[2].neg()]
+}
+
+/// Per lane, `a` where `m` has the lane's bit, else `b`.
+#[inline(always)]
+pub fn select3<D: Vector64<N>, const N: usize>(m: u32, a: D3<D>, b: D3<D>) -> D3<D> {
+    [
+        D::select(m, a[0], b[0]),
+        D::select(m, a[1], b[1]),
+        D::select(m, a[2], b[2]),
+    ]
+}
