@@ -251,15 +251,16 @@ impl ImportanceMap {
         ]
     }
 
-    /// The atlas points of N lanes' marginal/conditional samples, in lockstep.
+    /// The atlas points of N lanes' marginal/conditional samples, in lockstep; each lane's
+    /// texel record is prefetched as soon as its search ends (2 MB, read at random).
     #[inline(always)]
     fn cdf_uv_lanes<V: Vector<N>, const N: usize>(
         &self,
         cdf: &MarginalConditional,
-        t: &TexelMap,
         u0: V,
         u1: V,
     ) -> (V, V) {
+        let t = &self.texels;
         let (mut a, mut b) = ([0.0f32; N], [0.0f32; N]);
         u0.store(&mut a);
         u1.store(&mut b);
@@ -316,7 +317,7 @@ impl ImportanceMap {
             return None;
         }
         let (u, v) = match sampler {
-            EnvSampler::Cdf => self.cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, t, u0, u1),
+            EnvSampler::Cdf => self.cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, u0, u1),
             EnvSampler::Hierarchical => Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, u0, u1),
         };
         let k = t.index_lanes::<V, WIDTH>(u, v);
