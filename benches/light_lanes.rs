@@ -1,15 +1,21 @@
 //! Cost of sampling a light for 16 shading points: one call over lanes (`Light::sample_lanes`,
 //! on each ISA) against 16 scalar calls (`Light::sample`), for the samplers that run over lanes
-//! in f64 (the spherical rectangle, the sphere's cone). docs/tracer.md quotes the result.
+//! in f64 (the spherical rectangle and triangle, the sphere's cone) and the lat/long
+//! environment's two samplers. docs/tracer.md quotes the result.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use dibench::env::{EnvMethod, EnvSampler, Environment, Repr, synthetic_environment};
+use dibench::geometry::triangle::Triangle;
+use dibench::lights::environment::EnvironmentLight;
+use dibench::lights::mesh::TriangleLight;
 use dibench::lights::quad::QuadLight;
 use dibench::lights::sphere::SphereLight;
-use dibench::lights::{LaneQuery, LaneSamples, Light, LightMethods, QuadMethod};
+use dibench::lights::{LaneQuery, LaneSamples, Light, LightMethods, MeshMethod, QuadMethod};
 use dibench::sampling::stream::SampleStream;
 use dibench::simd::{Isa, WIDTH};
 use glam::Vec3;
 use std::hint::black_box;
+use std::sync::Arc;
 use std::time::Duration;
 
 /// 64 packets of points on a floor 1.5 below the light, facing up, with random sample numbers.
@@ -88,6 +94,35 @@ fn light_lanes(c: &mut Criterion) {
         radiance: Vec3::ONE,
     };
     bench_light(c, "sphere-cone", &sphere, &LightMethods::BASIC);
+    // Facing down: (v1 − v0) × (v2 − v0) is −Y.
+    let triangle = TriangleLight::new(
+        Triangle::new(
+            Vec3::new(-0.5, 1.5, -0.5),
+            Vec3::new(0.5, 1.5, -0.5),
+            Vec3::new(0.0, 1.5, 0.5),
+        ),
+        Vec3::ONE,
+    )
+    .unwrap();
+    let solid_angle = LightMethods {
+        mesh: MeshMethod::SolidAngle,
+        ..LightMethods::BASIC
+    };
+    bench_light(c, "triangle-solid-angle", &triangle, &solid_angle);
+    let env = EnvironmentLight {
+        env: Arc::new(Environment::build(&synthetic_environment(50.0))),
+        scene_radius: 1.0,
+    };
+    for sampler in EnvSampler::ALL {
+        let m = LightMethods {
+            env: EnvMethod {
+                repr: Repr::LatLong,
+                sampler,
+            },
+            ..LightMethods::BASIC
+        };
+        bench_light(c, &format!("env-latlong-{}", sampler.name()), &env, &m);
+    }
 }
 
 criterion_group!(benches, light_lanes);
