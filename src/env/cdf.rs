@@ -16,8 +16,8 @@ pub struct MarginalConditional {
 /// Index i with cdf[i] ≤ u·total < cdf[i+1], and the offset of u inside that cell, for N lanes
 /// in lockstep, each lane in its own cumulative array (starting at 0, with a positive total) of
 /// `len + 1` entries from `data[start[i]]`. Cells of zero width are never chosen. The
-/// search is branchless (Knuth's uniform binary search, in the form of Khuong & Morin,
-/// "Array Layouts for Comparison-Based Searching", 2017, §3): every lane takes the same
+/// search is branch-free (the halving search of Khuong & Morin, "Array Layouts for
+/// Comparison-Based Searching", 2017): every lane takes the same
 /// ⌈log₂ len⌉ steps, so the lanes' loads overlap instead of each waiting behind the branch
 /// mispredictions of the one before. It finds the same index as `partition_point`, the unique
 /// first entry above the target in a non-decreasing array.

@@ -87,13 +87,12 @@ impl<D: Copy> SphericalTriangle<D> {
     {
         let k = D::splat;
         let (n_ab, n_bc, n_ca) = (cross3(a, b), cross3(b, c), cross3(c, a));
-        let zero = k(0.0);
-        let all = (u64::MAX >> (64 - N)) as u32;
-        let mut valid = all
-            & !(dot3(n_ab, n_ab).eq(zero) | dot3(n_bc, n_bc).eq(zero) | dot3(n_ca, n_ca).eq(zero));
-        // Lanes with a vertex on another's great circle take three orthogonal normals instead,
-        // so that nothing below is 0/0.
         let (o, l) = (k(0.0), k(1.0));
+        let all = (u64::MAX >> (64 - N)) as u32;
+        let mut valid =
+            all & !(dot3(n_ab, n_ab).eq(o) | dot3(n_bc, n_bc).eq(o) | dot3(n_ca, n_ca).eq(o));
+        // Lanes where two vertices are parallel (a zero normal) take three orthogonal normals
+        // instead, so that nothing below is 0/0.
         let n_ab = normalize3(select3(valid, n_ab, [l, o, o]));
         let n_bc = normalize3(select3(valid, n_bc, [o, l, o]));
         let n_ca = normalize3(select3(valid, n_ca, [o, o, l]));
@@ -101,7 +100,7 @@ impl<D: Copy> SphericalTriangle<D> {
         let beta = angle_between(n_bc, neg3(n_ab));
         let gamma = angle_between(n_ca, neg3(n_bc));
         let area = alpha.add(beta).add(gamma).sub(k(PI));
-        valid &= zero.lt(area);
+        valid &= o.lt(area);
         (
             SphericalTriangle {
                 a,
