@@ -29,12 +29,15 @@ impl TileLayout {
 
     /// Pixel coordinates of lane `lane` of tile `tile`, or None past the image edge.
     pub fn lane_pixel(&self, tile: usize, lane: usize) -> Option<(u32, u32)> {
-        let (tx, ty) = (tile as u32 % self.tiles_x, tile as u32 / self.tiles_x);
-        let (x, y) = (
-            tx * TILE + lane as u32 % TILE,
-            ty * TILE + lane as u32 / TILE,
-        );
+        let (x0, y0) = self.tile_origin(tile);
+        let (x, y) = (x0 + lane as u32 % TILE, y0 + lane as u32 / TILE);
         (x < self.width && y < self.height).then_some((x, y))
+    }
+
+    /// The pixel coordinates of tile `tile`'s top left pixel (lane 0).
+    pub fn tile_origin(&self, tile: usize) -> (u32, u32) {
+        let t = tile as u32;
+        (t % self.tiles_x * TILE, t / self.tiles_x * TILE)
     }
 
     pub fn index(&self, x: u32, y: u32) -> usize {

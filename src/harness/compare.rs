@@ -15,7 +15,7 @@ use crate::output::run_dir::{RunDir, Status};
 use crate::output::store::Store;
 use crate::output::{Provenance, write_csv, write_exr_with};
 use crate::prepare::PreparedScene;
-use crate::render::Renderer;
+use crate::render::{Renderer, group_size};
 use crate::sampling::{SampleGenerator, Setup};
 use crate::strategy::{Integrand, Skipped, Strategy};
 use serde::Deserialize;
@@ -196,11 +196,13 @@ pub struct StrategyRun {
 /// checkpoints. Time spent measuring the error is excluded from the clock.
 ///
 /// Budget bound: a pass is the unit of work (a partial pass would leave some pixels with one
-/// sample fewer and bias the mean). At equal time the loop predicts the next pass's duration
-/// as the mean pass time so far and starts it only if it is predicted to end within the
-/// budget: the final time lies within about one pass of the budget, on either side, and the
-/// measured deviation is reported (`time_s` of the last row, `overshoot` in summary.csv). At
-/// equal spp it renders exactly N passes; checkpoint k is at ⌈N / 2^(K−1−k)⌉ passes.
+/// sample fewer and bias the mean). Passes are rendered in groups of up to 16
+/// ([`Renderer::add_passes`]), each group the same film as its passes one by one. At equal
+/// time the loop predicts each pass's duration as the mean pass time so far and starts only
+/// as many passes as are predicted to end within the budget: the final time lies within about
+/// one pass of the budget, on either side, and the measured deviation is reported (`time_s` of
+/// the last row, `overshoot` in summary.csv). At equal spp it renders exactly N passes;
+/// checkpoint k is at ⌈N / 2^(K−1−k)⌉ passes, and no group runs past a checkpoint.
 pub fn run_strategy(
     scene: &PreparedScene,
     strategy: &dyn Strategy,
@@ -262,8 +264,32 @@ pub fn run_strategy(
         if done {
             break;
         }
+        // Passes go in groups (one pixel's samples share a packet): as many as are
+        // predicted to end within the budget, and none past the next checkpoint.
+        let per_pass = (film.spp > 0).then(|| elapsed.as_secs_f64() / film.spp as f64);
+        let left = match (opts.budget, per_pass) {
+            (Budget::Time(_), None) => 1,
+            (Budget::Time(t), Some(p)) => {
+                let e = elapsed.as_secs_f64();
+                let fits = ((t - e) / p).floor();
+                let to_checkpoint = if next < CHECKPOINTS - 1 {
+                    ((t / scale(next) - e) / p).ceil()
+                } else {
+                    f64::INFINITY
+                };
+                fits.min(to_checkpoint).max(1.0) as u64
+            }
+            (Budget::Spp(n), _) => {
+                let target = if next < CHECKPOINTS - 1 {
+                    (n as f64 / scale(next)).ceil() as u64
+                } else {
+                    n
+                };
+                target.min(n).saturating_sub(film.spp)
+            }
+        };
         let start = Instant::now();
-        renderer.add_pass(&mut film);
+        renderer.add_passes(&mut film, group_size(left, per_pass));
         elapsed += start.elapsed();
         on_progress(elapsed, film.spp);
         if next < CHECKPOINTS - 1 && reached(next, film.spp, elapsed) {

@@ -279,8 +279,9 @@ pub fn render(
 ) -> Result<Image> {
     let mut r = Renderer::new(scene, strategy, seed)?;
     let mut film = Film::new(scene.scene.width, scene.scene.height);
-    for _ in 0..passes {
-        r.add_pass(&mut film);
+    while film.spp < passes {
+        let count = (passes - film.spp).min(crate::render::MAX_GROUP);
+        r.add_passes(&mut film, count);
     }
     Ok(film.mean())
 }

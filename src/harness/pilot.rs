@@ -15,7 +15,7 @@ use crate::error::Result;
 use crate::film::Film;
 use crate::math::mix64;
 use crate::prepare::PreparedScene;
-use crate::render::Renderer;
+use crate::render::{Renderer, group_size};
 use crate::strategy::{Integrand, Strategy};
 use std::time::{Duration, Instant};
 
@@ -63,11 +63,21 @@ pub fn pilot(
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     renderer.add_pass(&mut film);
     let start = Instant::now();
+    // In groups, as compare renders (Renderer::add_passes), so the time per pass is what a
+    // compared run pays.
     while film.spp < MIN_PASSES || start.elapsed() < time {
         if crate::interrupt::requested() {
             break;
         }
-        renderer.add_pass(&mut film);
+        let elapsed = start.elapsed().as_secs_f64();
+        let timed = film.spp - 1;
+        let per_pass = (timed > 0).then(|| elapsed / timed as f64);
+        let left = match per_pass {
+            _ if film.spp < MIN_PASSES => MIN_PASSES - film.spp,
+            Some(p) => ((time.as_secs_f64() - elapsed) / p).ceil().max(1.0) as u64,
+            None => 1,
+        };
+        renderer.add_passes(&mut film, group_size(left, per_pass));
     }
     let timed = (film.spp - 1).max(1) as f64;
     Ok(Pilot {

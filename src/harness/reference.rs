@@ -11,7 +11,7 @@ use crate::math::mix64;
 use crate::output::store::{Locked, NewFile, Store};
 use crate::output::{decode_exr, encode_exr};
 use crate::prepare::PreparedScene;
-use crate::render::Renderer;
+use crate::render::{Renderer, group_size};
 use crate::strategy::{Integrand, reference_strategy};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -244,8 +244,25 @@ pub fn render_with(
         if done {
             break;
         }
-        renderer.add_pass(&mut film);
-        bar.inc(1);
+        // Passes go in groups (Renderer::add_passes), ending on every pass the loop looks
+        // at: a checkpoint, a multiple of 8 where the floor is measured, the spp asked for.
+        let elapsed = start.elapsed().as_secs_f64();
+        let per_pass = (film.spp > 0).then(|| elapsed / film.spp as f64);
+        let mut left = match checkpoints {
+            Some(_) => next_checkpoint.saturating_sub(film.spp),
+            None => u64::MAX,
+        };
+        if floor.is_some() {
+            left = left.min(8 - film.spp % 8);
+        } else if time.is_none() {
+            left = left.min(spp.saturating_sub(film.spp));
+        }
+        if let (Some(t), Some(p)) = (time, per_pass) {
+            left = left.min(((t.as_secs_f64() - elapsed) / p).ceil().max(1.0) as u64);
+        }
+        let count = group_size(left, per_pass);
+        renderer.add_passes(&mut film, count);
+        bar.inc(count);
         if let Some(unit) = checkpoints
             && film.spp == next_checkpoint
         {

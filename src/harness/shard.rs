@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::output::store::{Locked, NewFile, Store};
 use crate::prepare::PreparedScene;
-use crate::render::Renderer;
+use crate::render::{Renderer, group_size};
 use crate::strategy::Integrand;
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -95,7 +95,9 @@ pub fn render(
     let mut film = Film::new(scene.scene.width, scene.scene.height);
     let start = Instant::now();
     let _polling = crate::interrupt::polling();
-    for pass in (spec.index..total_spp).step_by(spec.count as usize) {
+    // This shard's passes are index, index + count, … below total_spp.
+    let mut next = spec.index;
+    while next < total_spp {
         if crate::interrupt::requested() {
             return Err(Error::Interrupted(format!(
                 "shard {}/{} of the {} reference stopped at {} spp; nothing stored",
@@ -105,7 +107,14 @@ pub fn render(
                 film.spp
             )));
         }
-        renderer.add_pass_with_stream(&mut film, pass);
+        // In groups (Renderer::add_passes_with_streams): the same film as pass by pass.
+        let per_pass = (film.spp > 0).then(|| start.elapsed().as_secs_f64() / film.spp as f64);
+        let left = (total_spp - next).div_ceil(spec.count);
+        let streams: Vec<u64> = (0..group_size(left, per_pass))
+            .map(|i| next + i * spec.count)
+            .collect();
+        renderer.add_passes_with_streams(&mut film, &streams);
+        next = next.saturating_add(streams.len() as u64 * spec.count);
     }
     let meta = ShardMeta {
         scene: scene.scene.name.clone(),
