@@ -7,7 +7,7 @@
 //! `begin_pass` with all shading points, then every tile's shading phase.
 
 use crate::error::{Error, Result};
-use crate::film::{Accumulation, Film, TileLayout};
+use crate::film::{Accumulation, Film, TILE, TileLayout};
 use crate::geometry::Ray;
 use crate::geometry::triangle::Triangle;
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
@@ -263,10 +263,12 @@ impl<'a> Renderer<'a> {
                 |(tile, scratch), (t, (sum, m2))| {
                     for &(offset, c) in &groups {
                         let streams = &streams[offset..offset + c];
+                        let pass: [u64; LANES] = std::array::from_fn(|l| streams[l & (c - 1)]);
+                        let slots = &BLOCK_SLOTS[c.trailing_zeros() as usize];
                         // radiance[j][pixel]: pass j of the group, the tile's pixels in order.
                         let mut radiance = [[Vec3::ZERO; LANES]; MAX_GROUP as usize];
                         for block in 0..c {
-                            let samples = block_lanes(&layout, t, block, streams);
+                            let samples = LaneSamples::new(&layout, t, slots[block], pass);
                             if samples.active == 0 {
                                 continue;
                             }
@@ -305,9 +307,11 @@ impl<'a> Renderer<'a> {
         let mut active: LaneMask = 0;
         let mut pixels = [u32::MAX; LANES];
         let mut px = PixelLanes::default();
+        let (x0, y0) = samples.origin;
         for lane in 0..LANES {
             if samples.active >> lane & 1 != 0 {
-                let (x, y) = (samples.x[lane], samples.y[lane]);
+                let slot = samples.slot[lane] as u32;
+                let (x, y) = (x0 + slot % TILE, y0 + slot / TILE);
                 pixels[lane] = y * w + x;
                 px.x[lane] = x as f32;
                 px.y[lane] = y as f32;
@@ -568,52 +572,72 @@ pub fn group_size(left: u64, per_pass: Option<f64>) -> u64 {
     left.min(MAX_GROUP).min(by_time).max(1)
 }
 
-/// Which sample each lane of a camera packet takes: pixel (x, y) of pass (sample index)
-/// `pass` in the lanes of `active`, and the pixel's place in its tile (lane = 4·dy + dx).
-#[derive(Default)]
+/// Which sample each lane of a camera packet takes: the pixel at place `slot` (4·dy + dx) of
+/// the tile whose top left pixel is `origin`, in pass (sample index) `pass`, in the lanes of
+/// `active`.
 struct LaneSamples {
-    x: [u32; LANES],
-    y: [u32; LANES],
-    pass: [u64; LANES],
+    origin: (u32, u32),
     slot: [u8; LANES],
+    pass: [u64; LANES],
     active: LaneMask,
+}
+
+impl LaneSamples {
+    /// Lanes at places `slot` of tile `tile`, active where their pixel is in the image.
+    fn new(layout: &TileLayout, tile: usize, slot: [u8; LANES], pass: [u64; LANES]) -> Self {
+        let origin = layout.tile_origin(tile);
+        let inside =
+            |dx: u32, dy: u32| origin.0 + dx < layout.width && origin.1 + dy < layout.height;
+        let active = if inside(TILE - 1, TILE - 1) {
+            LaneMask::MAX
+        } else {
+            (0..LANES)
+                .filter(|&l| inside(slot[l] as u32 % TILE, slot[l] as u32 / TILE))
+                .fold(0, |m, l| m | 1 << l)
+        };
+        LaneSamples {
+            origin,
+            slot,
+            pass,
+            active,
+        }
+    }
 }
 
 /// Tile `tile` of one pass: lane = 4·dy + dx, the film's order within a tile.
 fn tile_lanes(layout: &TileLayout, tile: usize, pass: u64) -> LaneSamples {
-    let mut s = LaneSamples::default();
-    for lane in 0..LANES {
-        if let Some((x, y)) = layout.lane_pixel(tile, lane) {
-            (s.x[lane], s.y[lane], s.pass[lane]) = (x, y, pass);
-            s.slot[lane] = lane as u8;
-            s.active |= 1 << lane;
-        }
-    }
-    s
+    LaneSamples::new(
+        layout,
+        tile,
+        std::array::from_fn(|l| l as u8),
+        [pass; LANES],
+    )
 }
 
-/// Packet `block` of a group of c = `streams.len()` passes (a power of two) over tile
-/// `tile`: 16/c of the tile's pixels, each in c neighbouring lanes (lane = c·pixel + pass).
-/// The tile's pixels are taken in Morton order, so a packet's pixels are a 4×2, 2×2, 2×1 or
-/// 1×1 block.
-fn block_lanes(layout: &TileLayout, tile: usize, block: usize, streams: &[u64]) -> LaneSamples {
-    // c is a power of two: shifts and masks, where divisions by it were 3 % of a cornell pass.
-    let shift = streams.len().trailing_zeros();
-    let (x0, y0) = layout.tile_origin(tile);
-    let mut s = LaneSamples::default();
-    for lane in 0..LANES {
-        let m = block << (4 - shift) | lane >> shift;
-        let (dx, dy) = (m & 1 | (m >> 1) & 2, (m >> 1) & 1 | (m >> 2) & 2);
-        let (x, y) = (x0 + dx as u32, y0 + dy as u32);
-        s.slot[lane] = (4 * dy + dx) as u8;
-        if x < layout.width && y < layout.height {
-            (s.x[lane], s.y[lane]) = (x, y);
-            s.pass[lane] = streams[lane & ((1 << shift) - 1)];
-            s.active |= 1 << lane;
+/// Lanes' places in the tile (4·dy + dx) for each group size c = 2^shift and packet `block`
+/// of it: 16/c of the tile's pixels, each in c neighbouring lanes (lane = c·pixel + pass),
+/// the pixels taken in Morton order, so a packet's pixels are a 4×4, 4×2, 2×2, 2×1 or 1×1
+/// block. A table: computed lane by lane for every packet, they were 4 % of a sphere_light
+/// pass.
+const BLOCK_SLOTS: [[[u8; LANES]; LANES]; 5] = {
+    let mut t = [[[0u8; LANES]; LANES]; 5];
+    let mut shift = 0;
+    while shift < 5 {
+        let mut block = 0;
+        while block < 1 << shift {
+            let mut lane = 0;
+            while lane < LANES {
+                let m = block << (4 - shift) | lane >> shift;
+                let (dx, dy) = (m & 1 | (m >> 1) & 2, (m >> 1) & 1 | (m >> 2) & 2);
+                t[shift][block][lane] = (4 * dy + dx) as u8;
+                lane += 1;
+            }
+            block += 1;
         }
+        shift += 1;
     }
-    s
-}
+    t
+};
 
 /// Pinhole camera ray through pixel (x, y) at sub-pixel offset `u` (a box filter).
 pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ray {
