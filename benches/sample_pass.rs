@@ -1,10 +1,11 @@
-//! Cost of one sample pass (one sample per pixel over the whole image) per strategy per scene:
-//! the t_sample in Veach's efficiency 1/(σ²·t_sample).
+//! Cost of sample passes (one sample per pixel over the whole image) per strategy per scene:
+//! the t_sample in Veach's efficiency 1/(σ²·t_sample). Each iteration renders a group of
+//! 16 passes, as `compare` renders them (`Renderer::add_passes`); the throughput is samples.
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use dibench::film::Film;
 use dibench::prepare::PreparedScene;
-use dibench::render::Renderer;
+use dibench::render::{MAX_GROUP, Renderer};
 use dibench::scene::Scene;
 use dibench::strategy::applicable;
 use dibench::tracer::backends;
@@ -22,11 +23,14 @@ fn sample_pass(c: &mut Criterion) {
         group
             .sample_size(10)
             .warm_up_time(Duration::from_millis(300))
-            .measurement_time(Duration::from_secs(2));
+            .measurement_time(Duration::from_secs(2))
+            .throughput(Throughput::Elements(
+                scene.scene.width as u64 * scene.scene.height as u64 * MAX_GROUP,
+            ));
         for s in &strategies {
             let mut renderer = Renderer::new(&scene, s.as_ref(), 1).unwrap();
             let mut film = Film::new(scene.scene.width, scene.scene.height);
-            group.bench_function(s.name(), |b| b.iter(|| renderer.add_pass(&mut film)));
+            group.bench_function(s.name(), |b| b.iter(|| renderer.add_passes(&mut film, MAX_GROUP)));
         }
         group.finish();
     }
