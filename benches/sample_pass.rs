@@ -30,7 +30,9 @@ fn sample_pass(c: &mut Criterion) {
         for s in &strategies {
             let mut renderer = Renderer::new(&scene, s.as_ref(), 1).unwrap();
             let mut film = Film::new(scene.scene.width, scene.scene.height);
-            group.bench_function(s.name(), |b| b.iter(|| renderer.add_passes(&mut film, MAX_GROUP)));
+            group.bench_function(s.name(), |b| {
+                b.iter(|| renderer.add_passes(&mut film, MAX_GROUP))
+            });
         }
         group.finish();
     }

@@ -267,8 +267,8 @@ impl<'a> Renderer<'a> {
                         let slots = &BLOCK_SLOTS[c.trailing_zeros() as usize];
                         // radiance[j][pixel]: pass j of the group, the tile's pixels in order.
                         let mut radiance = [[Vec3::ZERO; LANES]; MAX_GROUP as usize];
-                        for block in 0..c {
-                            let samples = LaneSamples::new(&layout, t, slots[block], pass);
+                        for &block in &slots[..c] {
+                            let samples = LaneSamples::new(&layout, t, block, pass);
                             if samples.active == 0 {
                                 continue;
                             }
@@ -304,18 +304,17 @@ impl<'a> Renderer<'a> {
         let (w, h) = (shape.width, shape.height);
         out.radiance = [Vec3::ZERO; LANES];
         out.packet.mask = 0;
-        let mut active: LaneMask = 0;
+        let active = samples.active;
         let mut pixels = [u32::MAX; LANES];
         let mut px = PixelLanes::default();
         let (x0, y0) = samples.origin;
-        for lane in 0..LANES {
-            if samples.active >> lane & 1 != 0 {
+        for (lane, pixel) in pixels.iter_mut().enumerate() {
+            if active >> lane & 1 != 0 {
                 let slot = samples.slot[lane] as u32;
                 let (x, y) = (x0 + slot % TILE, y0 + slot / TILE);
-                pixels[lane] = y * w + x;
+                *pixel = y * w + x;
                 px.x[lane] = x as f32;
                 px.y[lane] = y as f32;
-                active |= 1 << lane;
             }
         }
         let keys = std::array::from_fn(|lane| SampleKey {
