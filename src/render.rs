@@ -1,5 +1,7 @@
 //! One sample per pixel over the whole image, in 4×4 tiles: a 16-ray camera packet, then the
 //! estimator's shadow and emission probes as two more packets. Parallel over tiles with rayon.
+//! Passes are rendered in groups of up to 16 ([`Renderer::add_passes`]), whose packets hold
+//! several passes' samples of fewer pixels, down to one pixel's 16 samples: the same film.
 //!
 //! A pass runs in two phases per tile — the camera phase (sample values, camera rays, shading
 //! points) and the shading phase (probes, their packets, the radiance) — back to back, or, for
@@ -160,9 +162,9 @@ impl<'a> Renderer<'a> {
     /// next pass: shard i of n renders passes i, i + n, … (see `harness::shard`), and the
     /// merged film equals a sequential render's up to roundoff.
     pub fn add_pass_with_stream(&mut self, film: &mut Film, stream: u64) {
-        let update = Accumulation::of_count(film.spp);
-        let layout = film.layout;
         if self.estimator.wants_pass_points() {
+            let update = Accumulation::of_count(film.spp);
+            let layout = film.layout;
             let tiles: Vec<CameraTile> = (0..layout.tile_count())
                 .into_par_iter()
                 .map_init(TileScratch::default, |scratch, t| {
@@ -193,22 +195,10 @@ impl<'a> Renderer<'a> {
                     let radiance = this.shading_phase(tile, scratch);
                     update.add_tile(this.isa, sum, m2, &radiance);
                 });
+            film.spp += 1;
         } else {
-            let this = &*self;
-            film.sum
-                .par_chunks_mut(16)
-                .zip(film.m2.par_chunks_mut(16))
-                .enumerate()
-                .for_each_init(
-                    || (CameraTile::new(), TileScratch::default()),
-                    |(tile, scratch), (t, (sum, m2))| {
-                        this.camera_phase(&layout, &tile_lanes(&layout, t, stream), tile, scratch);
-                        let radiance = this.shading_phase(tile, scratch);
-                        update.add_tile(this.isa, sum, m2, &radiance);
-                    },
-                );
+            self.add_passes_with_streams(film, &[stream]);
         }
-        film.spp += 1;
     }
 
     /// Adds `count` (at most [`MAX_GROUP`]) passes to the film, numbered from its next pass:
@@ -1004,12 +994,36 @@ mod group_tests {
         (b(&film.sum), b(&film.m2), film.spp)
     }
 
-    /// Passes rendered in groups make the film that passes one by one make, bit for bit: for
-    /// groups of every size up to 16 (13 = 8 + 4 + 1), for a shard's strided passes, in scenes
-    /// with quads, a sphere, a mesh light and an environment, at a size with partial tiles,
-    /// for light, BSDF and MIS estimators (emission rays included). Control: the same group
-    /// with two passes' samples swapped between lanes makes a different film, so the test
-    /// sees which lane a pass's sample went to.
+    /// One pass the plain way, written out independently of the groups: each tile's 16
+    /// pixels in one packet in the film's lane order, then the film's update of the tile.
+    fn pass_tile_by_tile(r: &Renderer, film: &mut Film, stream: u64) {
+        let layout = film.layout;
+        let update = Accumulation::of_count(film.spp);
+        let (mut tile, mut scratch) = (CameraTile::new(), TileScratch::default());
+        for (t, (sum, m2)) in film
+            .sum
+            .chunks_mut(16)
+            .zip(film.m2.chunks_mut(16))
+            .enumerate()
+        {
+            r.camera_phase(
+                &layout,
+                &tile_lanes(&layout, t, stream),
+                &mut tile,
+                &mut scratch,
+            );
+            let radiance = r.shading_phase(&tile, &mut scratch);
+            update.add_tile(r.isa, sum, m2, &radiance);
+        }
+        film.spp += 1;
+    }
+
+    /// Passes rendered in groups make the film that passes one by one, tile by tile make, bit
+    /// for bit: for groups of every size up to 16 (13 = 8 + 4 + 1; `add_pass` is a group of
+    /// one), for a shard's strided passes, in scenes with quads, a sphere, a mesh light and an
+    /// environment, at a size with partial tiles, for light, BSDF and MIS estimators (emission
+    /// rays included). Control: a group's passes in reverse order make a different film, so
+    /// the test sees which lane's sample went to which pass.
     #[test]
     fn grouped_passes_equal_passes_one_by_one() {
         let cases = [
@@ -1026,21 +1040,30 @@ mod group_tests {
             let scene = PreparedScene::new(scene);
             let strategy = crate::strategy::by_name(strategy).unwrap();
             let mut r = Renderer::new(&scene, strategy.as_ref(), 11).unwrap();
-            // Passes 0..16 one by one, then 16..29 as 13, 29..31 as 2, 31..32 as 1, 32..48 as 16.
+            // Passes 0..16 as 16, 16..29 as 13, 29..31 as 2, 31..32 as 1, 32..48 as 16.
             let mut want = Film::new(30, 22);
-            for _ in 0..48 {
-                r.add_pass(&mut want);
+            for pass in 0..48 {
+                pass_tile_by_tile(&r, &mut want, pass);
             }
             let mut got = Film::new(30, 22);
             for count in [16, 13, 2, 1, 16] {
                 r.add_passes(&mut got, count);
             }
+            let mut single = Film::new(30, 22);
+            for _ in 0..48 {
+                r.add_pass(&mut single);
+            }
+            assert!(
+                bits(&single) == bits(&want),
+                "{name} {} add_pass",
+                strategy.name()
+            );
             assert!(bits(&got) == bits(&want), "{name} {}", strategy.name());
             // A shard's passes 3, 8, 13, …: five at a time against one at a time.
             let streams: Vec<u64> = (0..10).map(|i| 3 + 5 * i).collect();
             let (mut one, mut five) = (Film::new(30, 22), Film::new(30, 22));
             for &s in &streams {
-                r.add_pass_with_stream(&mut one, s);
+                pass_tile_by_tile(&r, &mut one, s);
             }
             r.add_passes_with_streams(&mut five, &streams[..5]);
             r.add_passes_with_streams(&mut five, &streams[5..]);
