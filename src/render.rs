@@ -987,6 +987,7 @@ mod tests {
 mod group_tests {
     use super::*;
     use crate::scene::Scene;
+    use std::sync::{Arc, Mutex};
 
     /// The film's bits: every pixel's sum and M2, and the pass count.
     fn bits(film: &Film) -> (Vec<[u64; 3]>, Vec<[u64; 3]>, u64) {
@@ -1086,6 +1087,111 @@ mod group_tests {
         let mut film = Film::new(30, 22);
         r.add_passes(&mut film, 16);
         bits(&film)
+    }
+
+    /// A strategy whose estimator is another's, made image-space: it asks for every pass's
+    /// points first and records, per pass, how many it got and whether each sits at its own
+    /// pixel.
+    struct PassPointsOf(Box<dyn Strategy>, Arc<Mutex<Vec<(usize, bool)>>>);
+
+    struct PassPointsEstimator<'s> {
+        inner: Box<dyn Estimator + 's>,
+        seen: Arc<Mutex<Vec<(usize, bool)>>>,
+    }
+
+    impl Strategy for PassPointsOf {
+        /// The inner strategy's name: it keys the random streams, so the samples are the same.
+        fn name(&self) -> String {
+            self.0.name()
+        }
+        fn describe(&self) -> String {
+            self.0.describe()
+        }
+        fn integrand(&self) -> crate::strategy::Integrand {
+            self.0.integrand()
+        }
+        fn bind<'s>(
+            &self,
+            scene: SceneView<'s>,
+        ) -> std::result::Result<Box<dyn Estimator + 's>, String> {
+            Ok(Box::new(PassPointsEstimator {
+                inner: self.0.bind(scene)?,
+                seen: self.1.clone(),
+            }))
+        }
+    }
+
+    impl Estimator for PassPointsEstimator<'_> {
+        fn layout(&self) -> crate::sampling::Layout {
+            self.inner.layout()
+        }
+        fn sample(
+            &self,
+            sp: &ShadingPoint,
+            u: &mut crate::sampling::Dims,
+        ) -> crate::strategy::Probes {
+            self.inner.sample(sp, u)
+        }
+        fn emission_weight(
+            &self,
+            sp: &ShadingPoint,
+            probe: &EmissionProbe,
+            hit: &SurfaceHit,
+        ) -> f32 {
+            self.inner.emission_weight(sp, probe, hit)
+        }
+        fn env_weight(&self, sp: &ShadingPoint, probe: &EmissionProbe) -> f32 {
+            self.inner.env_weight(sp, probe)
+        }
+        fn wants_pass_points(&self) -> bool {
+            true
+        }
+        fn begin_pass(&mut self, pass: &PassPoints) {
+            let mut count = 0;
+            let mut placed = pass.points.len() == (pass.width * pass.height) as usize;
+            for (i, p) in pass.points.iter().enumerate() {
+                if let Some(p) = p {
+                    count += 1;
+                    placed &= p.pixel as usize == i;
+                }
+            }
+            self.seen.lock().unwrap().push((count, placed));
+        }
+    }
+
+    /// An image-space estimator gets every pass's points, each at its own pixel, before it
+    /// shades them, also when passes are asked for in groups, and makes the film that the
+    /// same estimator shading point by point makes (the lane-by-lane default of
+    /// `sample_packet` against the packet path). By hand: groups that skip the image-space
+    /// path (no `begin_pass`), and points stored at transposed pixels, both fail it.
+    #[test]
+    fn an_image_space_estimator_gets_each_pass_and_the_same_film() {
+        for (name, strategy) in [
+            ("cornell", "mis-power"),
+            ("env_venice_bunny", "mis-env-latlong-cdf"),
+        ] {
+            let mut scene = Scene::load(&Scene::resolve(name).unwrap()).unwrap();
+            (scene.width, scene.height) = (30, 22);
+            let scene = PreparedScene::new(scene);
+            let seen = Arc::new(Mutex::new(Vec::new()));
+            let wrapped = PassPointsOf(crate::strategy::by_name(strategy).unwrap(), seen.clone());
+            let mut image_space = Renderer::new(&scene, &wrapped, 5).unwrap();
+            let plain = Renderer::new(&scene, wrapped.0.as_ref(), 5).unwrap();
+            let (mut got, mut want) = (Film::new(30, 22), Film::new(30, 22));
+            for count in [5, 16, 1] {
+                image_space.add_passes(&mut got, count);
+            }
+            for pass in 0..22 {
+                pass_tile_by_tile(&plain, &mut want, pass);
+            }
+            assert!(bits(&got) == bits(&want), "{name}");
+            let seen = seen.lock().unwrap();
+            assert_eq!(seen.len(), 22, "{name}: one begin_pass per pass");
+            assert!(
+                seen.iter().all(|&(n, placed)| n > 300 && placed),
+                "{name}: {seen:?}"
+            );
+        }
     }
 
     /// Group sizes stay within a packet, the passes left and about a quarter second, and are
