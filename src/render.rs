@@ -233,14 +233,19 @@ impl<'a> Renderer<'a> {
             }
             return;
         }
-        let first = film.spp;
         let layout = film.layout;
-        // Powers of two, largest first: 13 passes are groups of 8, 4 and 1.
+        // Powers of two, largest first: 13 passes are groups of 8, 4 and 1. Per group, once
+        // for every tile: each lane's pass, and each pass's film update.
         let mut groups = Vec::new();
         let mut offset = 0;
         while offset < streams.len() {
             let c = 1usize << (streams.len() - offset).ilog2();
-            groups.push((offset, c));
+            let of_group = &streams[offset..offset + c];
+            let pass: [u64; LANES] = std::array::from_fn(|l| of_group[l & (c - 1)]);
+            let update: Vec<Accumulation> = (0..c)
+                .map(|j| Accumulation::of_count(film.spp + (offset + j) as u64))
+                .collect();
+            groups.push((c, pass, update));
             offset += c;
         }
         let this = &*self;
@@ -251,14 +256,12 @@ impl<'a> Renderer<'a> {
             .for_each_init(
                 || (CameraTile::new(), TileScratch::default()),
                 |(tile, scratch), (t, (sum, m2))| {
-                    for &(offset, c) in &groups {
-                        let streams = &streams[offset..offset + c];
-                        let pass: [u64; LANES] = std::array::from_fn(|l| streams[l & (c - 1)]);
-                        let slots = &BLOCK_SLOTS[c.trailing_zeros() as usize];
+                    for (c, pass, update) in &groups {
+                        let c = *c;
                         // radiance[j][pixel]: pass j of the group, the tile's pixels in order.
                         let mut radiance = [[Vec3::ZERO; LANES]; MAX_GROUP as usize];
-                        for &block in &slots[..c] {
-                            let samples = LaneSamples::new(&layout, t, block, pass);
+                        for &block in &BLOCK_SLOTS[c.trailing_zeros() as usize][..c] {
+                            let samples = LaneSamples::new(&layout, t, block, *pass);
                             if samples.active == 0 {
                                 continue;
                             }
@@ -268,9 +271,8 @@ impl<'a> Renderer<'a> {
                                 radiance[lane & (c - 1)][slot as usize] = got[lane];
                             }
                         }
-                        for (j, x) in radiance[..c].iter().enumerate() {
-                            Accumulation::of_count(first + (offset + j) as u64)
-                                .add_tile(this.isa, sum, m2, x);
+                        for (u, x) in update.iter().zip(&radiance) {
+                            u.add_tile(this.isa, sum, m2, x);
                         }
                     }
                 },

@@ -285,7 +285,7 @@ pub fn run_strategy(
                 } else {
                     n
                 };
-                target.min(n).saturating_sub(film.spp)
+                target.saturating_sub(film.spp)
             }
         };
         let start = Instant::now();
