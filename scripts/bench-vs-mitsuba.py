@@ -7,6 +7,7 @@ Setup (once):
     export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1   # the default here
 Run (from the repository root, with the venv's python):
     /work/mitsuba-venv/bin/python scripts/bench-vs-mitsuba.py --dibench target/release/dibench
+  add `--baseline OTHER_BINARY` to time a second build in the same rounds (before/after a change).
 
 Each scene's TOML is translated into a Mitsuba scene dict:
   camera   `perspective`, fov = fov_y_deg, fov_axis='y', to_world = look_at(eye, look_at, up);
@@ -208,15 +209,18 @@ def main():
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--time", type=float, default=5.0, help="dibench seconds per strategy per round")
     ap.add_argument("--dibench", default="target/release/dibench")
+    ap.add_argument("--baseline", help="a second dibench binary (say, the build before a change), run "
+                    "in every round beside --dibench, the two in alternating order")
     ap.add_argument("--out", type=Path, help="output directory (default: a new temporary one)")
     args = ap.parse_args()
     out = (args.out or Path(tempfile.mkdtemp(prefix="bench-vs-mitsuba-"))).resolve()
     out.mkdir(parents=True, exist_ok=True)
     exe = str(Path(args.dibench).resolve())
+    base_exe = str(Path(args.baseline).resolve()) if args.baseline else None
     mi, dr = import_mitsuba(out)
     import numpy as np
 
-    scenes, mit_t, dib_t, diffs = {}, {}, {}, {}
+    scenes, mit_t, dib_t, base_t, diffs = {}, {}, {}, {}, {}
     for name in args.scenes.split(","):
         for est, (ne, nb) in ESTIMATORS.items():
             try:
@@ -240,35 +244,52 @@ def main():
                 t, diffs[name, est] = time_mitsuba(mi, dr, scene, args.spp, r)  # scene's runs slower
                 mit_t.setdefault((name, est), []).append(px * args.spp / t)
             strats = [scenes[name, est][2] for est in ESTIMATORS]
-            res = run_dibench(exe, name, strats, args.time, out / f"dibench-round{r}")
+            order = [(exe, dib_t, "dibench")] + ([(base_exe, base_t, "baseline")] if base_exe else [])
+            for binary, times, tag in (order if r % 2 else order[::-1]):
+                got = run_dibench(binary, name, strats, args.time, out / f"{tag}-round{r}")
+                for est in ESTIMATORS:
+                    times.setdefault((name, est), []).append(scenes[name, est][1] * got[scenes[name, est][2]][0])
+                if tag == "dibench":
+                    res = got
             for est in ESTIMATORS:
-                sps, exr = res[scenes[name, est][2]]
-                dib_t.setdefault((name, est), []).append(scenes[name, est][1] * sps)
+                exr = res[scenes[name, est][2]][1]
                 diffs[name, est] = image_diffs(np, diffs[name, est], np.array(mi.Bitmap(str(exr))))
             print(f"round {r} {name}: " + ", ".join(
                 f"{e} mitsuba {mit_t[name, e][-1] / 1e6:.2f} M/s, dibench {dib_t[name, e][-1] / 1e6:.2f} M/s"
+                + (f", baseline {base_t[name, e][-1] / 1e6:.2f} M/s" if base_exe else "")
                 for e in ESTIMATORS), flush=True)
 
     rows = []
     print(f"\n{'scene':18} {'estimator':10} {'dibench strategy':22} {'mitsuba M/s min/med/max':>24} "
-          f"{'dibench M/s min/med/max':>24} {'ratio':>6} {'mean Δ':>7} {'blocks':>6} {'mirr.':>6}")
+          f"{'dibench M/s min/med/max':>24} {'ratio':>6} {'mean Δ':>7} {'blocks':>6} {'mirr.':>6}"
+          + (f" {'base ratio':>10} {'new/base':>8}" if base_exe else ""))
     for (name, est), (scene, px, strat) in scenes.items():
         m, b = sorted(mit_t[name, est]), sorted(dib_t[name, est])
         ratio = statistics.median(x / y for x, y in zip(dib_t[name, est], mit_t[name, est]))
         mean_rel, blk, mirr = diffs[name, est]
         fmt = lambda v: "/".join(f"{x / 1e6:.2f}" for x in (v[0], statistics.median(v), v[-1]))
+        extra, cols = "", []
+        if base_exe:
+            bt = base_t[name, est]
+            base_ratio = statistics.median(x / y for x, y in zip(bt, mit_t[name, est]))
+            speedup = statistics.median(x / y for x, y in zip(dib_t[name, est], bt))
+            extra = f" {base_ratio:10.2f} {speedup:8.3f}"
+            cols = [f"{statistics.median(bt):.0f}", f"{base_ratio:.3f}", f"{speedup:.3f}"]
         print(f"{name:18} {est:10} {strat:22} {fmt(m):>24} {fmt(b):>24} {ratio:6.2f} {mean_rel:7.2%} "
-              f"{blk:6.3f} {mirr:6.3f}")
+              f"{blk:6.3f} {mirr:6.3f}" + extra)
         rows.append([name, est, f"{statistics.median(m):.0f}", f"{statistics.median(b):.0f}", f"{ratio:.3f}",
-                     f"{mean_rel:.4f}", f"{blk:.4f}", f"{mirr:.4f}"])
+                     f"{mean_rel:.4f}", f"{blk:.4f}", f"{mirr:.4f}"] + cols)
     with open(out / "bench-vs-mitsuba.csv", "w", newline="") as f:
         wr = csv.writer(f)
         wr.writerow(["scene", "estimator", "mitsuba_samples_per_s", "dibench_samples_per_s", "ratio",
-                     "image_mean_rel_diff", "block_rel_rms_diff", "block_rel_rms_diff_mirrored"])
+                     "image_mean_rel_diff", "block_rel_rms_diff", "block_rel_rms_diff_mirrored"]
+                    + (["baseline_samples_per_s", "baseline_ratio", "speedup_over_baseline"] if base_exe else []))
         wr.writerows(rows)
     print(f"\nratio: median over rounds of dibench ÷ Mitsuba samples/s (interleaved); "
           f"mean Δ: max per-channel relative difference of the image means; blocks / mirr.: relative "
-          f"RMS difference of 8×8-pixel block means, as is / one image mirrored.\n"
+          f"RMS difference of 8×8-pixel block means, as is / one image mirrored"
+          + ("; base ratio: the baseline's ratio; new/base: median of per-round dibench ÷ baseline" if base_exe else "")
+          + ".\n"
           f"CSV: {out / 'bench-vs-mitsuba.csv'}")
 
 

@@ -57,6 +57,21 @@ impl Welford {
     }
 }
 
+/// Pearson's correlation of two equally long samples (two passes: means, then centred sums).
+pub fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(
+        a.len(),
+        b.len(),
+        "correlation of samples of different lengths"
+    );
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}
+
 /// Two-sided critical t for significance α with `dof` degrees of freedom.
 pub fn t_critical(alpha: f64, dof: f64) -> f64 {
     use statrs::distribution::{ContinuousCDF, StudentsT};

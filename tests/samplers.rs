@@ -12,6 +12,7 @@ use dibench::sampling::{
     Dims, GENERATORS, Layout, SampleGenerator, SampleKey, Setup, generator, stream::name_id,
 };
 use dibench::scene::Scene;
+use dibench::stats::correlation;
 use dibench::strategy::{ShadingPoint, registry};
 use glam::Vec3;
 use std::path::Path;
@@ -328,16 +329,6 @@ fn unbiased_over_randomizations() {
 
 fn unit(x: u32) -> f64 {
     x as f64 / 4_294_967_296.0
-}
-
-/// Pearson correlation of two equally long series.
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
 }
 
 /// No dimension is used twice within a sample: across 4,096 samples (64 pixels × 64 passes)

@@ -4,11 +4,14 @@
 use crate::math::{mix64, mix64_lanes};
 use crate::simd::{Vector, VectorU64, WIDTH};
 
-/// PCG32 (O'Neill 2014: 64-bit LCG state, XSH-RR output), seeded exactly as
-/// `rand_pcg::Pcg32::seed_from_u64` seeds it, so every stream is bit-identical to the crate's
-/// (the `matches_rand_pcg` test). Written out because the crate's byte-wise seeding was 12 % of
-/// a `light` sample on `cornell` (`perf record`, one thread): one stream is seeded per pixel and
-/// pass, and only a handful of values are drawn from each.
+/// PCG32 (O'Neill 2014: 64-bit LCG state, XSH-RR output). A key's stream is the crate's
+/// `rand_pcg::Pcg32::new(state, stream)` (the `matches_rand_pcg` test), its LCG stream (the
+/// increment) hashed from (seed, strategy, pixel) and its start from that and the pass
+/// ([`SampleStream::key_words`]). One stream is seeded per pixel and pass and only a handful
+/// of values are drawn from each, so seeding is much of the cost: here it is two SplitMix64
+/// finalisers and one LCG step. (`seed_from_u64`'s seeding, which the streams followed up to
+/// stop 42, draws four words from a second PCG32 on top: five more 64-bit multiplies and four
+/// output permutations per sample, which AVX2 emulates; docs/tracer.md, stop 43.)
 pub struct SampleStream {
     state: u64,
     increment: u64,
@@ -16,8 +19,6 @@ pub struct SampleStream {
 
 /// PCG's 64-bit LCG multiplier (O'Neill 2014, §4.3.1).
 const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
-/// The increment of the PCG32 that `SeedableRng::seed_from_u64` draws seed words from.
-const SEED_INCREMENT: u64 = 11_634_580_027_462_260_723;
 
 /// XSH-RR of every lane (O'Neill 2014, §6.3.1): xorshift the high bits down, then rotate the
 /// 32-bit word by the top five bits; each output in the low half of its lane. The rotation is
@@ -35,18 +36,11 @@ fn step<U: VectorU64<N>, const N: usize>(state: U, increment: U) -> U {
     state.mul(U::splat(MULTIPLIER)).add(increment)
 }
 
-/// `seed_from_u64` of every lane: four words of a PCG32 started at `key` (advanced before
-/// each output) form the little-endian state and stream; the increment is made odd, added
-/// once, and the LCG stepped once. Returns (state, increment).
+/// `rand_pcg::Pcg32::new(state, stream)` of every lane: the increment is the stream made odd,
+/// added to the state once, and the LCG stepped once. Returns (state, increment).
 #[inline(always)]
-fn seeded<U: VectorU64<N>, const N: usize>(key: U) -> (U, U) {
-    let seed_increment = U::splat(SEED_INCREMENT);
-    let s1 = step(key, seed_increment);
-    let s2 = step(s1, seed_increment);
-    let s3 = step(s2, seed_increment);
-    let s4 = step(s3, seed_increment);
-    let state = xsh_rr(s1).or(xsh_rr(s2).shl(32));
-    let increment = xsh_rr(s3).or(xsh_rr(s4).shl(32)).or(U::splat(1));
+fn pcg32_new<U: VectorU64<N>, const N: usize>(state: U, stream: U) -> (U, U) {
+    let increment = stream.shl(1).or(U::splat(1));
     (step(state.add(increment), increment), increment)
 }
 
@@ -82,15 +76,19 @@ impl SampleStream {
     /// ISA gives the same bits.
     #[inline(always)]
     pub fn keyed_lanes<U: VectorU64<N>, const N: usize>(base: U, pixel: U, pass: U) -> (U, U) {
-        let pass = pass.mul(U::splat(0x9E37_79B9_7F4A_7C15));
-        seeded(mix64_lanes(mix64_lanes(base.xor(pixel)).xor(pass)))
+        let (state, stream) = Self::key_words(base, pixel, pass);
+        pcg32_new(state, stream)
     }
 
-    /// `seed_from_u64(key)`.
-    #[cfg(test)]
-    fn from_u64(key: u64) -> Self {
-        let (state, increment) = seeded(key);
-        SampleStream { state, increment }
+    /// The PCG32 (state, stream) words of a key: the stream is a hash of (`base`, pixel), so
+    /// each pixel draws from an LCG sequence of its own, and the start is a hash of that and
+    /// the pass, so a pixel's passes start at unrelated points of it (two passes' draws
+    /// overlap with a chance of about draws/2⁶⁴ per pair).
+    #[inline(always)]
+    pub fn key_words<U: VectorU64<N>, const N: usize>(base: U, pixel: U, pass: U) -> (U, U) {
+        let stream = mix64_lanes(base.xor(pixel));
+        let state = mix64_lanes(stream.xor(pass.mul(U::splat(0x9E37_79B9_7F4A_7C15))));
+        (state, stream)
     }
 
     /// Every lane's next output as its top 24 bits (an integer below 2²⁴; times 2⁻²⁴ it is
@@ -142,26 +140,79 @@ pub fn name_id(name: &str) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use rand_core::{RngCore, SeedableRng};
+    use rand_core::RngCore;
 
-    /// Every stream is the crate's `Pcg32::seed_from_u64(key)` stream, word for word, over keys
-    /// that exercise every bit of the state (zero, all ones, SplitMix outputs) — so images made
-    /// before the stream was written out are unchanged.
+    /// Every stream is the crate's `Pcg32::new(state, stream)` stream, word for word, over
+    /// words that exercise every bit (zero, all ones, SplitMix outputs).
     #[test]
     fn matches_rand_pcg() {
-        let keys = (0..2000u64)
-            .map(mix64)
-            .chain([0, 1, u64::MAX, 1 << 63, 0x5555_5555_5555_5555]);
-        for key in keys {
-            let mut ours = SampleStream::from_u64(key);
-            let mut theirs = rand_pcg::Pcg32::seed_from_u64(key);
+        let words = (0..2000u64).map(|i| (mix64(i), mix64(i ^ 0x5eed))).chain([
+            (0, 0),
+            (1, u64::MAX),
+            (u64::MAX, 1 << 63),
+            (0x5555_5555_5555_5555, 0),
+        ]);
+        for (state, stream) in words {
+            let (s, increment) = pcg32_new(state, stream);
+            let mut ours = SampleStream {
+                state: s,
+                increment,
+            };
+            let mut theirs = rand_pcg::Pcg32::new(state, stream);
             for draw in 0..24 {
                 assert_eq!(
                     ours.next_u32(),
                     theirs.next_u32(),
-                    "key {key:#x}, draw {draw}"
+                    "words {state:#x} {stream:#x}, draw {draw}"
                 );
             }
         }
+    }
+
+    /// The streams of a block of pixels and passes (neighbouring keys, the most alike) share
+    /// no pair of consecutive outputs, within a stream or across streams, and the first
+    /// outputs of neighbouring passes and of neighbouring pixels do not correlate
+    /// (|r| < 5/√n). Controls: a key that ignores the pass (each pixel's passes one stream)
+    /// and one that ignores the pixel are caught.
+    #[test]
+    fn neighbouring_keys_give_unrelated_streams() {
+        fn check(words: impl Fn(u64, u64, u64) -> (u64, u64)) -> Result<(), String> {
+            let (pixels, passes, draws) = (64usize, 128usize, 8);
+            let base = SampleStream::base(3, 0x11);
+            let mut seen = std::collections::HashSet::new();
+            let mut first = vec![vec![0.0f64; passes]; pixels];
+            for (pixel, row) in first.iter_mut().enumerate() {
+                for (pass, x) in row.iter_mut().enumerate() {
+                    let (state, stream) = words(base, pixel as u64, pass as u64);
+                    let (state, increment) = pcg32_new(state, stream);
+                    let mut s = SampleStream { state, increment };
+                    let out: Vec<u64> = (0..draws).map(|_| s.next_u32() as u64).collect();
+                    *x = out[0] as f64;
+                    for pair in out.windows(2) {
+                        if !seen.insert(pair[0] << 32 | pair[1]) {
+                            return Err(format!("pixel {pixel} pass {pass} repeats a pair"));
+                        }
+                    }
+                }
+            }
+            let by_pass: (Vec<f64>, Vec<f64>) = first
+                .iter()
+                .flat_map(|row| row.windows(2).map(|w| (w[0], w[1])))
+                .unzip();
+            let by_pixel: (Vec<f64>, Vec<f64>) = first
+                .windows(2)
+                .flat_map(|w| w[0].iter().copied().zip(w[1].iter().copied()))
+                .unzip();
+            for (what, (a, b)) in [("passes", by_pass), ("pixels", by_pixel)] {
+                let r = crate::stats::correlation(&a, &b);
+                if r.abs() >= 5.0 / (a.len() as f64).sqrt() {
+                    return Err(format!("neighbouring {what} correlate: r = {r}"));
+                }
+            }
+            Ok(())
+        }
+        check(SampleStream::key_words).unwrap();
+        assert!(check(|b, px, _| SampleStream::key_words(b, px, 0)).is_err());
+        assert!(check(|b, _, pass| SampleStream::key_words(b, 0, pass)).is_err());
     }
 }
