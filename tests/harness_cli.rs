@@ -530,12 +530,13 @@ fn exit_statuses_tell_the_kind_of_error() {
 }
 
 /// `warp`'s verdict re-tests a failed χ² once, independently with 4× the samples: a correct
-/// sampler that fails at one seed by chance (`env-octa-cdf`, seed 1: p = 5.1e-3 < 0.01)
+/// sampler that fails at one seed by chance (`env-octa-cdf`, seed 48: p = 3.9e-3 < 0.01; the
+/// seed was found anew when the random streams' seeding changed, since seed 1 now passes)
 /// passes, and a wrong one (`phong-lecture`) still fails, naming both p-values.
 #[test]
 fn warp_retests_before_it_says_failed() {
     let dir = tempfile::tempdir().unwrap();
-    let (code, stdout, stderr) = dibench(&["warp", "env-octa-cdf", "--seed", "1"], dir.path());
+    let (code, stdout, stderr) = dibench(&["warp", "env-octa-cdf", "--seed", "48"], dir.path());
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(stdout.contains("re-testing"), "{stdout}");
     assert!(
