@@ -5,7 +5,7 @@
 use criterion::{Criterion, black_box, criterion_group, criterion_main};
 use dibench::sampling::GENERATORS;
 use dibench::sampling::generator::MAX_DIMENSIONS;
-use dibench::sampling::{Layout, SampleKey, Setup};
+use dibench::sampling::{Layout, SampleKeys, Setup};
 use dibench::simd::WIDTH;
 use dibench::strategy::{direction::BSDF_DIMS, light_sampling::LIGHT_DIMS};
 
@@ -23,12 +23,12 @@ fn fill_lanes(c: &mut Criterion) {
             b.iter(|| {
                 pass = (pass + 1) % 1024;
                 for packet in 0..64u64 {
-                    let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
-                        seed: 1,
-                        strategy: 0x5eed,
-                        pixel: packet * WIDTH as u64 + i as u64,
-                        index: pass,
-                    });
+                    let keys = SampleKeys::of_render(
+                        1,
+                        0x5eed,
+                        std::array::from_fn(|i| packet * WIDTH as u64 + i as u64),
+                        [pass; WIDTH],
+                    );
                     g.fill_lanes(&setup, &keys, 0xffff, dims, &mut out);
                     black_box(&out);
                 }

@@ -10,19 +10,19 @@
 
 use crate::error::{Error, Result};
 use crate::film::{Accumulation, Film, TILE, TileLayout};
-use crate::geometry::Ray;
 use crate::geometry::triangle::Triangle;
+use crate::geometry::{Hit, Ray};
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
 use crate::sampling::generator::MAX_DIMENSIONS;
 use crate::sampling::stream::name_id;
-use crate::sampling::{GENERATORS, LaneValues, PacketDims, SampleGenerator, SampleKey, Setup};
+use crate::sampling::{GENERATORS, LaneValues, PacketDims, SampleGenerator, SampleKeys, Setup};
 use crate::scene::Camera;
 use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector};
 use crate::strategy::{
     EmissionProbe, Estimator, PassPoints, ProbePacket, ShadingLanes, ShadingPacket, ShadingPoint,
     Strategy,
 };
-use crate::tracer::{HitPacket, LANES, LaneMask, RayPacket};
+use crate::tracer::{HitPacket, LANES, LaneMask, NO_HIT, RayPacket};
 use glam::Vec3;
 use rayon::prelude::*;
 
@@ -298,23 +298,27 @@ impl<'a> Renderer<'a> {
         out.packet.mask = 0;
         let active = samples.active;
         let mut pixels = [u32::MAX; LANES];
+        let mut pixel_keys = [0u64; LANES];
         let mut px = PixelLanes::default();
         let (x0, y0) = samples.origin;
-        for (lane, pixel) in pixels.iter_mut().enumerate() {
-            if active >> lane & 1 != 0 {
-                let slot = samples.slot[lane] as u32;
-                let (x, y) = (x0 + slot % TILE, y0 + slot / TILE);
-                *pixel = y * w + x;
-                px.x[lane] = x as f32;
-                px.y[lane] = y as f32;
-            }
+        // Every lane, without a branch, so it compiles to vector code: an inactive lane's place
+        // lies outside the image (finite coordinates no one reads) and its pixel is u32::MAX.
+        for lane in 0..LANES {
+            let slot = samples.slot[lane] as u32;
+            let (x, y) = (x0 + slot % TILE, y0 + slot / TILE);
+            let pixel = if active >> lane & 1 != 0 {
+                y.wrapping_mul(w).wrapping_add(x)
+            } else {
+                u32::MAX
+            };
+            pixels[lane] = pixel;
+            pixel_keys[lane] = pixel as u64;
+            // Through i32 (exact: sides are at most MAX_IMAGE_SIDE), which SSE2 converts four at
+            // a time.
+            px.x[lane] = x as i32 as f32;
+            px.y[lane] = y as i32 as f32;
         }
-        let keys = std::array::from_fn(|lane| SampleKey {
-            seed: self.seed,
-            strategy: self.strategy_id,
-            pixel: pixels[lane] as u64,
-            index: samples.pass[lane],
-        });
+        let keys = SampleKeys::of_render(self.seed, self.strategy_id, pixel_keys, samples.pass);
         self.generator
             .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
         px.u = [out.values[0], out.values[1]];
@@ -336,36 +340,63 @@ impl<'a> Renderer<'a> {
             },
         );
         scene.tracer.intersect_packet_coherent(cam, active, hits);
-        // What the hit points need, gathered into lanes: triangle vertices and barycentrics,
-        // or a sphere hit's point (computed lane by lane: spheres are few).
+        // Which lanes hit something and which escaped, without a branch per lane.
+        let mut found = 0u32;
+        for (lane, &prim) in hits.prim.iter().enumerate() {
+            found |= ((prim != NO_HIT) as u32) << lane;
+        }
+        let hit_mask = found & active as u32;
+        let escaped = active as u32 & !hit_mask;
+        // The primitive every hit lane hit, if they share one: a packet of one pixel's
+        // samples mostly does (passes in groups), and then its lookups are made once.
+        let first = hits.prim[(hit_mask.trailing_zeros() as usize).min(LANES - 1)];
+        let mut other = 0u32;
+        for (lane, &prim) in hits.prim.iter().enumerate() {
+            other |= ((prim != first) as u32) << lane;
+        }
+        let shared = (hit_mask != 0 && other & hit_mask == 0).then_some(first as usize);
+        // What the hit points need, gathered into lanes: triangle vertices and barycentrics
+        // (one triangle's rows at once where every lane hit it), or a sphere hit's point
+        // (computed lane by lane: spheres are few). Lanes that did not hit get finite values
+        // no one reads.
         g.given = 0;
-        let mut hit_mask = 0u32;
-        let mut escaped = 0u32;
-        for lane in 0..LANES {
-            if active & (1 << lane) == 0 {
-                continue;
+        match shared.filter(|&prim| world.geometry.sphere_index(prim as u32).is_none()) {
+            Some(prim) => {
+                let t = &world.geometry.triangles[prim];
+                g.v = [Soa3::splat(t.v0), Soa3::splat(t.v1), Soa3::splat(t.v2)];
+                (g.b1, g.b2) = (hits.u, hits.v);
+                g.ng = Soa3::splat(world.triangle_normals[prim]);
             }
-            let Some(hit) = hits.get(lane) else {
-                escaped |= 1 << lane;
-                continue;
-            };
-            hit_mask |= 1 << lane;
-            match world.geometry.sphere_index(hit.prim) {
-                None => {
-                    let t = &world.geometry.triangles[hit.prim as usize];
-                    g.v[0].set(lane, t.v0);
-                    g.v[1].set(lane, t.v1);
-                    g.v[2].set(lane, t.v2);
-                    g.b1[lane] = hit.u;
-                    g.b2[lane] = hit.v;
-                    g.ng.set(lane, world.triangle_normals[hit.prim as usize]);
-                }
-                Some(_) => {
-                    let surf = world.surface(&cam.get(lane), &hit);
-                    g.p.set(lane, surf.p);
-                    g.p_error.set(lane, surf.p_error);
-                    g.ng.set(lane, surf.ng);
-                    g.given |= 1 << lane;
+            None => {
+                let mut rest = hit_mask;
+                while rest != 0 {
+                    let lane = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    let prim = hits.prim[lane];
+                    match world.geometry.sphere_index(prim) {
+                        None => {
+                            let t = &world.geometry.triangles[prim as usize];
+                            g.v[0].set(lane, t.v0);
+                            g.v[1].set(lane, t.v1);
+                            g.v[2].set(lane, t.v2);
+                            g.b1[lane] = hits.u[lane];
+                            g.b2[lane] = hits.v[lane];
+                            g.ng.set(lane, world.triangle_normals[prim as usize]);
+                        }
+                        Some(_) => {
+                            let hit = Hit {
+                                t: hits.t[lane],
+                                prim,
+                                u: hits.u[lane],
+                                v: hits.v[lane],
+                            };
+                            let surf = world.surface(&cam.get(lane), &hit);
+                            g.p.set(lane, surf.p);
+                            g.p_error.set(lane, surf.p_error);
+                            g.ng.set(lane, surf.ng);
+                            g.given |= 1 << lane;
+                        }
+                    }
                 }
             }
         }
@@ -399,13 +430,14 @@ impl<'a> Renderer<'a> {
                 geo,
             },
         );
+        let surface_of = |prim: usize| (world.prim_material[prim], world.prim_emitter[prim]);
+        let shared_surface = shared.map(surface_of);
         for (lane, &pixel) in pixels.iter().enumerate() {
             if hit_mask & (1 << lane) == 0 {
                 continue;
             }
-            let prim = hits.prim[lane] as usize;
-            let material = world.prim_material[prim];
-            let emitter = world.prim_emitter[prim];
+            let (material, emitter) =
+                shared_surface.unwrap_or_else(|| surface_of(hits.prim[lane] as usize));
             let p = p.get(lane);
             if self.direct && emitter.is_some() {
                 let surf = SurfaceHit {
@@ -821,12 +853,12 @@ mod tests {
                     active |= 1 << lane;
                 }
             }
-            let keys = pixels.map(|pixel| SampleKey {
-                seed: self.seed,
-                strategy: self.strategy_id,
-                pixel: pixel as u64,
-                index: pass,
-            });
+            let keys = SampleKeys::of_render(
+                self.seed,
+                self.strategy_id,
+                pixels.map(u64::from),
+                [pass; LANES],
+            );
             self.generator
                 .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
             for (lane, &(x, y)) in coords.iter().enumerate() {

@@ -3,7 +3,7 @@
 //! sample is independent of every other, so per-pixel sample variances are variances of i.i.d.
 //! draws — the assumption the harness's error predictions make.
 
-use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, SampleKeys, Setup};
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 use super::stream::{SampleStream, next_1d_lanes};
 
@@ -32,45 +32,23 @@ impl SampleGenerator for Independent {
     }
 
     /// The packet's sixteen streams side by side, as 64-bit lanes compiled for the CPU's ISA
-    /// (inactive lanes are computed too and their values are unspecified), with the
-    /// per-(seed, strategy) part of their keys computed once per packet when the lanes share
-    /// it. The same numbers as [`Self::fill`] (`lanes_fill_as_single_samples`,
-    /// `every_isa_fills_as_one_stream`).
+    /// (inactive lanes are computed too and their values are unspecified). The same numbers as
+    /// [`Self::fill`] (`lanes_fill_as_single_samples`, `every_isa_fills_as_one_stream`).
     fn fill_lanes(
         &self,
         _setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &SampleKeys,
         _lanes: Mask,
         dims: usize,
         out: &mut LaneValues,
     ) {
-        let first = (keys[0].seed, keys[0].strategy);
-        let shared = SampleStream::base(first.0, first.1);
-        let base = keys.map(|k| {
-            if (k.seed, k.strategy) == first {
-                shared
-            } else {
-                SampleStream::base(k.seed, k.strategy)
-            }
-        });
-        crate::simd::run(
-            Isa::best(),
-            FillLanes {
-                base,
-                pixel: keys.map(|k| k.pixel),
-                pass: keys.map(|k| k.index),
-                dims,
-                out,
-            },
-        );
+        crate::simd::run(Isa::best(), FillLanes { keys, dims, out });
     }
 }
 
 /// [`Independent::fill_lanes`]'s streams over the lane layer's u64 lanes, in the ISA's context.
 struct FillLanes<'a> {
-    base: [u64; WIDTH],
-    pixel: [u64; WIDTH],
-    pass: [u64; WIDTH],
+    keys: &'a SampleKeys,
     dims: usize,
     out: &'a mut LaneValues,
 }
@@ -79,9 +57,18 @@ impl Kernel for FillLanes<'_> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
-        let load = L::U::load;
+        let (load, k) = (L::U::load, self.keys);
+        // The per-(seed, strategy) part of the keys: hashed once when every lane shares it, as
+        // a render's packets do, else lane by lane. (An or of xors, not `all`: no early exit,
+        // so it vectorises.)
+        let differ = |row: &[u64; WIDTH]| row.iter().fold(0, |a, &x| a | (x ^ row[0])) != 0;
+        let base = if differ(&k.seed) || differ(&k.strategy) {
+            SampleStream::base_lanes(load(&k.seed), load(&k.strategy))
+        } else {
+            L::U::splat(SampleStream::base(k.seed[0], k.strategy[0]))
+        };
         let (mut state, increment) =
-            SampleStream::keyed_lanes(load(&self.base), load(&self.pixel), load(&self.pass));
+            SampleStream::keyed_lanes(base, load(&k.pixel), load(&k.index));
         for d in self.out.iter_mut().take(self.dims) {
             next_1d_lanes::<L::V, L::U>(&mut state, increment, d);
         }
@@ -123,37 +110,43 @@ mod lane_tests {
     use crate::sampling::generator::{MAX_DIMENSIONS, set_lane};
 
     /// Every ISA's build of the packet fill gives the numbers of one stream at a time, for
-    /// lanes of different strategies too (integer lanes: nothing may differ).
+    /// lanes of one render (their (seed, strategy) hashed once), of different strategies and of
+    /// different seeds (hashed lane by lane): integer lanes, so nothing may differ.
     #[test]
     fn every_isa_fills_as_one_stream() {
         let setup = Setup::point(Layout::default(), None);
         let dims = 11;
-        let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
-            seed: 9,
-            strategy: 0x5eed + (i as u64 % 3),
-            pixel: i as u64 * 1_000_003,
-            index: u64::MAX - i as u64,
-        });
-        let mut want = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
-        for (lane, k) in keys.iter().enumerate() {
-            let mut row = [0.0f32; MAX_DIMENSIONS];
-            INDEPENDENT.fill(&setup, *k, &mut row[..dims]);
-            set_lane(&mut want, lane, &row[..dims]);
-        }
-        for isa in Isa::available() {
-            let mut got = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
-            crate::simd::run(
-                isa,
-                FillLanes {
-                    base: keys.map(|k| SampleStream::base(k.seed, k.strategy)),
-                    pixel: keys.map(|k| k.pixel),
-                    pass: keys.map(|k| k.index),
-                    dims,
-                    out: &mut got,
-                },
-            );
-            let bits = |a: LaneValues| a.map(|r| r.map(f32::to_bits));
-            assert_eq!(bits(got), bits(want), "{isa:?}");
+        let families: [fn(usize) -> (u64, u64); 3] = [
+            |_| (9, 0x5eed),
+            |i| (9, 0x5eed + (i as u64 % 3)),
+            |i| (if i == 13 { 10 } else { 9 }, 0x5eed),
+        ];
+        for family in families {
+            let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
+                seed: family(i).0,
+                strategy: family(i).1,
+                pixel: i as u64 * 1_000_003,
+                index: u64::MAX - i as u64,
+            });
+            let mut want = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
+            for (lane, k) in keys.iter().enumerate() {
+                let mut row = [0.0f32; MAX_DIMENSIONS];
+                INDEPENDENT.fill(&setup, *k, &mut row[..dims]);
+                set_lane(&mut want, lane, &row[..dims]);
+            }
+            for isa in Isa::available() {
+                let mut got = [[0.0f32; WIDTH]; MAX_DIMENSIONS];
+                crate::simd::run(
+                    isa,
+                    FillLanes {
+                        keys: &SampleKeys::of(&keys),
+                        dims,
+                        out: &mut got,
+                    },
+                );
+                let bits = |a: LaneValues| a.map(|r| r.map(f32::to_bits));
+                assert_eq!(bits(got), bits(want), "{isa:?} {:?}", keys[13]);
+            }
         }
     }
 }

@@ -10,7 +10,7 @@ pub mod stream;
 pub mod warp;
 
 pub use generator::{
-    Dimension, Dims, LaneValues, Layout, PacketDims, SampleGenerator, SampleKey, Setup,
+    Dimension, Dims, LaneValues, Layout, PacketDims, SampleGenerator, SampleKey, SampleKeys, Setup,
 };
 
 crate::plugin::registry! {

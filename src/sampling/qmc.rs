@@ -8,7 +8,7 @@
 //! of the pair is a (0,m,2)-net in base 2; across groups the index is shuffled with a different
 //! seed, so no two groups are correlated.
 
-use super::generator::{LaneValues, MAX_DIMENSIONS, SampleKey, Setup};
+use super::generator::{LaneValues, MAX_DIMENSIONS, Setup};
 use crate::math::mix64_lanes;
 use crate::simd::{VectorU64, WIDTH};
 
@@ -129,26 +129,6 @@ pub fn to_unit_lanes<U: VectorU64<N>, const N: usize>(x: U, out: &mut [f32; N]) 
     x.shr(8).to_f32(out);
     for o in out.iter_mut() {
         *o *= UNIT;
-    }
-}
-
-/// A packet's sample keys as lanes: one array per key field, ready for `VectorU64::load`.
-#[derive(Clone, Copy)]
-pub struct LaneKeys {
-    pub seed: [u64; WIDTH],
-    pub strategy: [u64; WIDTH],
-    pub pixel: [u64; WIDTH],
-    pub index: [u64; WIDTH],
-}
-
-impl LaneKeys {
-    pub fn of(keys: &[SampleKey; WIDTH]) -> Self {
-        LaneKeys {
-            seed: keys.map(|k| k.seed),
-            strategy: keys.map(|k| k.strategy),
-            pixel: keys.map(|k| k.pixel),
-            index: keys.map(|k| k.index),
-        }
     }
 }
 

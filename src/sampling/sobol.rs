@@ -13,10 +13,10 @@
 //! strategies or pixels never share points. Past 2^32 samples of a pixel the index wraps into
 //! a fresh randomization (an epoch in the seed).
 
-use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
-use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, LaneGroups, LaneKeys, store_point_lanes};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, SampleKeys, Setup};
+use super::qmc::{owen_lanes, scrambled_pair, scrambled_point_lanes, LaneGroups, store_point_lanes};
 use crate::math::mix64_lanes;
-use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
+use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64};
 
 pub struct Sobol;
 
@@ -80,7 +80,7 @@ impl SampleGenerator for Sobol {
     fn fill_lanes(
         &self,
         setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &SampleKeys,
         _lanes: Mask,
         dims: usize,
         out: &mut LaneValues,
@@ -93,20 +93,20 @@ impl SampleGenerator for Sobol {
 /// first dimension, and whether it is a pair there), and the keys as lanes.
 struct FillLanes<'a> {
     groups: LaneGroups,
-    keys: LaneKeys,
+    keys: &'a SampleKeys,
     out: &'a mut LaneValues,
 }
 
 impl<'a> FillLanes<'a> {
     fn new(
         setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &'a SampleKeys,
         dims: usize,
         out: &'a mut LaneValues,
     ) -> Self {
         FillLanes {
             groups: LaneGroups::of(setup, dims),
-            keys: LaneKeys::of(keys),
+            keys,
             out,
         }
     }
@@ -134,6 +134,7 @@ impl Kernel for FillLanes<'_> {
 mod tests {
     use super::*;
     use crate::sampling::generator::assert_every_isa_fills_as_one_sample;
+    use crate::simd::WIDTH;
     use crate::sampling::{Dimension, Layout};
 
     /// Every ISA's packet fill gives each lane's single-sample numbers, for keys that differ
@@ -155,7 +156,7 @@ mod tests {
             &setup,
             &keys,
             dims,
-            |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, got)),
+            |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &SampleKeys::of(&keys), dims, got)),
             "",
         );
     }

@@ -9,8 +9,8 @@
 //! It needs N: under a time budget (`Setup::spp` None) `check` refuses, and `compare` says that
 //! `--sampler stratified` needs a fixed sample count.
 
-use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
-use super::qmc::{LaneGroups, LaneKeys};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, SampleKeys, Setup};
+use super::qmc::LaneGroups;
 use super::stream::{ONE_MINUS_EPSILON, SampleStream, next_1d_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
@@ -192,7 +192,7 @@ impl SampleGenerator for Stratified {
     fn fill_lanes(
         &self,
         setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &SampleKeys,
         _lanes: Mask,
         dims: usize,
         out: &mut LaneValues,
@@ -205,7 +205,7 @@ impl SampleGenerator for Stratified {
 struct FillLanes<'a> {
     groups: LaneGroups,
     strata: Strata,
-    keys: LaneKeys,
+    keys: &'a SampleKeys,
     jitter_base: [u64; WIDTH],
     epoch: [u64; WIDTH],
     k: [u64; WIDTH],
@@ -215,7 +215,7 @@ struct FillLanes<'a> {
 impl<'a> FillLanes<'a> {
     fn new(
         setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &'a SampleKeys,
         dims: usize,
         out: &'a mut LaneValues,
     ) -> Self {
@@ -224,10 +224,12 @@ impl<'a> FillLanes<'a> {
         FillLanes {
             groups: LaneGroups::of(setup, dims),
             strata,
-            keys: LaneKeys::of(keys),
-            jitter_base: keys.map(|k| SampleStream::base(jitter_seed(k.seed), k.strategy)),
-            epoch: keys.map(|k| k.index / n),
-            k: keys.map(|k| k.index % n),
+            keys,
+            jitter_base: std::array::from_fn(|i| {
+                SampleStream::base(jitter_seed(keys.seed[i]), keys.strategy[i])
+            }),
+            epoch: keys.index.map(|i| i / n),
+            k: keys.index.map(|i| i % n),
             out,
         }
     }
@@ -310,7 +312,7 @@ mod tests {
                 &setup,
                 &keys,
                 dims,
-                |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, got)),
+                |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &SampleKeys::of(&keys), dims, got)),
                 &format!("spp {spp}"),
             );
         }

@@ -1,7 +1,7 @@
 //! Deterministic random streams: one PCG32 stream per (seed, strategy, pixel, pass), so an image
 //! depends on the seed and never on thread scheduling or tile order.
 
-use crate::math::{mix64, mix64_lanes};
+use crate::math::mix64_lanes;
 use crate::simd::{Vector, VectorU64, WIDTH};
 
 /// PCG32 (O'Neill 2014: 64-bit LCG state, XSH-RR output). A key's stream is the crate's
@@ -60,7 +60,13 @@ impl SampleStream {
     /// computes it once per packet, not once per sample.
     #[inline]
     pub fn base(seed: u64, strategy: u64) -> u64 {
-        mix64(seed ^ mix64(strategy))
+        Self::base_lanes(seed, strategy)
+    }
+
+    /// [`Self::base`] of every lane.
+    #[inline(always)]
+    pub fn base_lanes<U: VectorU64<N>, const N: usize>(seed: U, strategy: U) -> U {
+        mix64_lanes(seed.xor(mix64_lanes(strategy)))
     }
 
     /// The stream of (`base`, pixel, pass): `new(seed, strategy, pixel, pass)` for
@@ -140,6 +146,7 @@ pub fn name_id(name: &str) -> u64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::mix64;
     use rand_core::RngCore;
 
     /// Every stream is the crate's `Pcg32::new(state, stream)` stream, word for word, over

@@ -17,8 +17,8 @@
 //! The Sobol point is taken from the low 32 bits of the permuted index; the bits above seed
 //! the coordinates' scrambles, so large images still get distinct points.
 
-use super::generator::{LaneValues, SampleGenerator, SampleKey, Setup};
-use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, LaneGroups, LaneKeys, store_point_lanes};
+use super::generator::{LaneValues, SampleGenerator, SampleKey, SampleKeys, Setup};
+use super::qmc::{ceil_log2, morton_2d, owen_lanes, scrambled_point_lanes, to_unit, LaneGroups, store_point_lanes};
 use crate::math::mix64_lanes;
 use crate::simd::{Isa, Kernel, Lanes, Mask, VectorU64, WIDTH};
 
@@ -208,7 +208,7 @@ impl SampleGenerator for ZSobol {
     fn fill_lanes(
         &self,
         setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &SampleKeys,
         _lanes: Mask,
         dims: usize,
         out: &mut LaneValues,
@@ -233,7 +233,7 @@ fn pixel_morton(setup: &Setup, pixel: u64) -> u64 {
 struct FillLanes<'a> {
     groups: LaneGroups,
     blocks: Blocks,
-    keys: LaneKeys,
+    keys: &'a SampleKeys,
     morton: [u64; WIDTH],
     out: &'a mut LaneValues,
 }
@@ -241,15 +241,15 @@ struct FillLanes<'a> {
 impl<'a> FillLanes<'a> {
     fn new(
         setup: &Setup,
-        keys: &[SampleKey; WIDTH],
+        keys: &'a SampleKeys,
         dims: usize,
         out: &'a mut LaneValues,
     ) -> Self {
         FillLanes {
             groups: LaneGroups::of(setup, dims),
             blocks: Blocks::of(setup),
-            keys: LaneKeys::of(keys),
-            morton: keys.map(|k| pixel_morton(setup, k.pixel)),
+            keys,
+            morton: keys.pixel.map(|p| pixel_morton(setup, p)),
             out,
         }
     }
@@ -383,7 +383,7 @@ mod tests {
                 &setup,
                 &keys,
                 dims,
-                |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &keys, dims, got)),
+                |isa, got| crate::simd::run(isa, FillLanes::new(&setup, &SampleKeys::of(&keys), dims, got)),
                 &format!("{}x{}", setup.width, setup.height),
             );
         }

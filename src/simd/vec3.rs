@@ -23,6 +23,16 @@ pub struct Soa3 {
 }
 
 impl Soa3 {
+    /// `v` in every lane.
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> Self {
+        Soa3 {
+            x: [v.x; WIDTH],
+            y: [v.y; WIDTH],
+            z: [v.z; WIDTH],
+        }
+    }
+
     #[inline(always)]
     pub fn set(&mut self, lane: usize, v: Vec3) {
         self.x[lane] = v.x;
