@@ -58,17 +58,22 @@ impl Kernel for FillLanes<'_> {
     #[inline(always)]
     fn run<L: Lanes>(self) {
         let (load, k) = (L::U::load, self.keys);
-        // The per-(seed, strategy) part of the keys: hashed once when every lane shares it, as
-        // a render's packets do, else lane by lane. (An or of xors, not `all`: no early exit,
-        // so it vectorises.)
+        // What the lanes share is hashed once: the (seed, strategy) of a render's packets,
+        // and the pixel too in a packet of one pixel's samples (passes in groups). (An or of
+        // xors, not `all`: no early exit, so it vectorises.)
         let differ = |row: &[u64; WIDTH]| row.iter().fold(0, |a, &x| a | (x ^ row[0])) != 0;
-        let base = if differ(&k.seed) || differ(&k.strategy) {
-            SampleStream::base_lanes(load(&k.seed), load(&k.strategy))
+        let stream = if differ(&k.seed) || differ(&k.strategy) {
+            let base = SampleStream::base_lanes(load(&k.seed), load(&k.strategy));
+            SampleStream::stream_word(base, load(&k.pixel))
         } else {
-            L::U::splat(SampleStream::base(k.seed[0], k.strategy[0]))
+            let base = SampleStream::base(k.seed[0], k.strategy[0]);
+            if differ(&k.pixel) {
+                SampleStream::stream_word(L::U::splat(base), load(&k.pixel))
+            } else {
+                L::U::splat(SampleStream::stream_word(base, k.pixel[0]))
+            }
         };
-        let (mut state, increment) =
-            SampleStream::keyed_lanes(base, load(&k.pixel), load(&k.index));
+        let (mut state, increment) = SampleStream::streamed_lanes(stream, load(&k.index));
         for d in self.out.iter_mut().take(self.dims) {
             next_1d_lanes::<L::V, L::U>(&mut state, increment, d);
         }
@@ -110,22 +115,27 @@ mod lane_tests {
     use crate::sampling::generator::{MAX_DIMENSIONS, set_lane};
 
     /// Every ISA's build of the packet fill gives the numbers of one stream at a time, for
-    /// lanes of one render (their (seed, strategy) hashed once), of different strategies and of
-    /// different seeds (hashed lane by lane): integer lanes, so nothing may differ.
+    /// lanes of one render (their (seed, strategy) hashed once), of one pixel too (its stream
+    /// word hashed once), and where one lane differs in seed, strategy or pixel (hashed lane
+    /// by lane): integer lanes, so nothing may differ.
     #[test]
     fn every_isa_fills_as_one_stream() {
         let setup = Setup::point(Layout::default(), None);
         let dims = 11;
-        let families: [fn(usize) -> (u64, u64); 3] = [
-            |_| (9, 0x5eed),
-            |i| (9, 0x5eed + (i as u64 % 3)),
-            |i| (if i == 13 { 10 } else { 9 }, 0x5eed),
+        // (seed, strategy, pixel) of lane i.
+        type Family = fn(u64) -> (u64, u64, u64);
+        let families: [Family; 5] = [
+            |i| (9, 0x5eed, i * 1_000_003),
+            |_| (9, 0x5eed, 77),
+            |i| (9, 0x5eed + (i % 3), i * 1_000_003),
+            |i| (if i == 13 { 10 } else { 9 }, 0x5eed, 77),
+            |i| (9, 0x5eed, if i == 13 { 78 } else { 77 }),
         ];
         for family in families {
             let keys: [SampleKey; WIDTH] = std::array::from_fn(|i| SampleKey {
-                seed: family(i).0,
-                strategy: family(i).1,
-                pixel: i as u64 * 1_000_003,
+                seed: family(i as u64).0,
+                strategy: family(i as u64).1,
+                pixel: family(i as u64).2,
                 index: u64::MAX - i as u64,
             });
             let mut want = [[0.0f32; WIDTH]; MAX_DIMENSIONS];

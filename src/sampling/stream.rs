@@ -82,8 +82,7 @@ impl SampleStream {
     /// ISA gives the same bits.
     #[inline(always)]
     pub fn keyed_lanes<U: VectorU64<N>, const N: usize>(base: U, pixel: U, pass: U) -> (U, U) {
-        let (state, stream) = Self::key_words(base, pixel, pass);
-        pcg32_new(state, stream)
+        Self::streamed_lanes(Self::stream_word(base, pixel), pass)
     }
 
     /// The PCG32 (state, stream) words of a key: the stream is a hash of (`base`, pixel), so
@@ -92,9 +91,26 @@ impl SampleStream {
     /// overlap with a chance of about draws/2⁶⁴ per pair).
     #[inline(always)]
     pub fn key_words<U: VectorU64<N>, const N: usize>(base: U, pixel: U, pass: U) -> (U, U) {
-        let stream = mix64_lanes(base.xor(pixel));
-        let state = mix64_lanes(stream.xor(pass.mul(U::splat(0x9E37_79B9_7F4A_7C15))));
-        (state, stream)
+        let stream = Self::stream_word(base, pixel);
+        (Self::start_word(stream, pass), stream)
+    }
+
+    /// A key's stream word, from (`base`, pixel) alone: a packet of one pixel's samples
+    /// hashes it once.
+    #[inline(always)]
+    pub fn stream_word<U: VectorU64<N>, const N: usize>(base: U, pixel: U) -> U {
+        mix64_lanes(base.xor(pixel))
+    }
+
+    #[inline(always)]
+    fn start_word<U: VectorU64<N>, const N: usize>(stream: U, pass: U) -> U {
+        mix64_lanes(stream.xor(pass.mul(U::splat(0x9E37_79B9_7F4A_7C15))))
+    }
+
+    /// [`Self::keyed_lanes`] from each lane's [`Self::stream_word`] and pass.
+    #[inline(always)]
+    pub fn streamed_lanes<U: VectorU64<N>, const N: usize>(stream: U, pass: U) -> (U, U) {
+        pcg32_new(Self::start_word(stream, pass), stream)
     }
 
     /// Every lane's next output as its top 24 bits (an integer below 2²⁴; times 2⁻²⁴ it is
