@@ -12,7 +12,9 @@ cd "$(dirname "$0")/.."
 # The suite in the `test-release` profile (release without fat LTO: see Cargo.toml); the system
 # tests then drive that profile's binary (DIBENCH_TARGET): the same code as the binary a user
 # runs, without a second, fat-LTO build of it (6 min of CI's 2 cores).
-cargo test --profile test-release
+# --no-fail-fast: one failing test binary does not hide the others' results (cargo stops at the
+# first otherwise); the script still fails.
+cargo test --profile test-release --no-fail-fast
 cargo build --profile test-release --bins --example exr_pixel
 export DIBENCH_TARGET=target/test-release
 scripts/install-test-tools.sh
