@@ -297,28 +297,26 @@ impl<'a> Renderer<'a> {
         out.radiance = [Vec3::ZERO; LANES];
         out.packet.mask = 0;
         let active = samples.active;
-        let mut pixels = [u32::MAX; LANES];
-        let mut pixel_keys = [0u64; LANES];
+        // Each lane's pixel, as the key row the generator reads (values below 2³²).
+        let mut pixels = [0u64; LANES];
         let mut px = PixelLanes::default();
         let (x0, y0) = samples.origin;
         // Every lane, without a branch, so it compiles to vector code: an inactive lane's place
         // lies outside the image (finite coordinates no one reads) and its pixel is u32::MAX.
-        for lane in 0..LANES {
+        for (lane, pixel) in pixels.iter_mut().enumerate() {
             let slot = samples.slot[lane] as u32;
             let (x, y) = (x0 + slot % TILE, y0 + slot / TILE);
-            let pixel = if active >> lane & 1 != 0 {
+            *pixel = if active >> lane & 1 != 0 {
                 y.wrapping_mul(w).wrapping_add(x)
             } else {
                 u32::MAX
-            };
-            pixels[lane] = pixel;
-            pixel_keys[lane] = pixel as u64;
+            } as u64;
             // Through i32 (exact: sides are at most MAX_IMAGE_SIDE), which SSE2 converts four at
             // a time.
             px.x[lane] = x as i32 as f32;
             px.y[lane] = y as i32 as f32;
         }
-        let keys = SampleKeys::of_render(self.seed, self.strategy_id, pixel_keys, samples.pass);
+        let keys = SampleKeys::of_render(self.seed, self.strategy_id, pixels, samples.pass);
         self.generator
             .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
         px.u = [out.values[0], out.values[1]];
@@ -450,7 +448,7 @@ impl<'a> Renderer<'a> {
                 out.radiance[lane] += self.view.emitted(&surf, cam.get(lane).dir);
             }
             bsdf[lane] = Some(&world.materials[material as usize]);
-            pixel_of[lane] = pixel;
+            pixel_of[lane] = pixel as u32;
         }
         out.packet.mask = hit_mask;
     }
