@@ -260,14 +260,14 @@ impl<'a> Renderer<'a> {
                         let c = *c;
                         // radiance[j][pixel]: pass j of the group, the tile's pixels in order.
                         let mut radiance = [[Vec3::ZERO; LANES]; MAX_GROUP as usize];
-                        for &block in &BLOCK_SLOTS[c.trailing_zeros() as usize][..c] {
-                            let samples = LaneSamples::new(&layout, t, block, *pass);
+                        for places in &BLOCK_PLACES[c.trailing_zeros() as usize][..c] {
+                            let samples = LaneSamples::new(&layout, t, places, *pass);
                             if samples.active == 0 {
                                 continue;
                             }
                             this.camera_phase(&layout, &samples, tile, scratch);
                             let got = this.shading_phase(tile, scratch);
-                            for (lane, &slot) in samples.slot.iter().enumerate() {
+                            for (lane, &slot) in samples.places.slot.iter().enumerate() {
                                 radiance[lane & (c - 1)][slot as usize] = got[lane];
                             }
                         }
@@ -297,29 +297,32 @@ impl<'a> Renderer<'a> {
         out.radiance = [Vec3::ZERO; LANES];
         out.packet.mask = 0;
         let active = samples.active;
-        // Each lane's pixel, as the key row the generator reads (values below 2³²).
-        let mut pixels = [0u64; LANES];
-        let mut px = PixelLanes::default();
+        // Each lane's pixel, as the key row the generator reads (values below 2³²), and its
+        // coordinates: whole rows from the places' tables. An inactive lane's place lies
+        // outside the image (finite coordinates no one reads) and its pixel is u32::MAX.
         let (x0, y0) = samples.origin;
-        // Every lane, without a branch, so it compiles to vector code: an inactive lane's place
-        // lies outside the image (finite coordinates no one reads) and its pixel is u32::MAX.
-        for (lane, pixel) in pixels.iter_mut().enumerate() {
-            let slot = samples.slot[lane] as u32;
-            let (x, y) = (x0 + slot % TILE, y0 + slot / TILE);
-            *pixel = if active >> lane & 1 != 0 {
-                y.wrapping_mul(w).wrapping_add(x)
-            } else {
-                u32::MAX
-            } as u64;
-            // Through i32 (exact: sides are at most MAX_IMAGE_SIDE), which SSE2 converts four at
-            // a time.
-            px.x[lane] = x as i32 as f32;
-            px.y[lane] = y as i32 as f32;
+        let pl = samples.places;
+        let mut pixels = [0u64; LANES];
+        for ((pixel, &dx), &dy) in pixels.iter_mut().zip(&pl.dx).zip(&pl.dy) {
+            *pixel = (y0 + dy).wrapping_mul(w).wrapping_add(x0 + dx) as u64;
         }
+        if active != LaneMask::MAX {
+            for (lane, pixel) in pixels.iter_mut().enumerate() {
+                if active >> lane & 1 == 0 {
+                    *pixel = u32::MAX as u64;
+                }
+            }
+        }
+        // Exact: sides are at most MAX_IMAGE_SIDE, far below 2²⁴.
+        let (fx0, fy0) = (x0 as f32, y0 as f32);
         let keys = SampleKeys::of_render(self.seed, self.strategy_id, pixels, samples.pass);
         self.generator
             .fill_lanes(&self.setup, &keys, active, self.dims, &mut out.values);
-        px.u = [out.values[0], out.values[1]];
+        let px = PixelLanes {
+            x: pl.fx.map(|d| fx0 + d),
+            y: pl.fy.map(|d| fy0 + d),
+            u: [out.values[0], out.values[1]],
+        };
         let TileScratch {
             cam,
             hits,
@@ -598,14 +601,14 @@ pub fn group_size(left: u64, per_pass: Option<f64>) -> u64 {
 /// `active`.
 struct LaneSamples {
     origin: (u32, u32),
-    slot: [u8; LANES],
+    places: &'static Places,
     pass: [u64; LANES],
     active: LaneMask,
 }
 
 impl LaneSamples {
-    /// Lanes at places `slot` of tile `tile`, active where their pixel is in the image.
-    fn new(layout: &TileLayout, tile: usize, slot: [u8; LANES], pass: [u64; LANES]) -> Self {
+    /// Lanes at `places` of tile `tile`, active where their pixel is in the image.
+    fn new(layout: &TileLayout, tile: usize, places: &'static Places, pass: [u64; LANES]) -> Self {
         let origin = layout.tile_origin(tile);
         let inside =
             |dx: u32, dy: u32| origin.0 + dx < layout.width && origin.1 + dy < layout.height;
@@ -613,26 +616,66 @@ impl LaneSamples {
             LaneMask::MAX
         } else {
             (0..LANES)
-                .filter(|&l| inside(slot[l] as u32 % TILE, slot[l] as u32 / TILE))
+                .filter(|&l| inside(places.dx[l], places.dy[l]))
                 .fold(0, |m, l| m | 1 << l)
         };
         LaneSamples {
             origin,
-            slot,
+            places,
             pass,
             active,
         }
     }
 }
 
+/// Each lane's place in its tile (`slot` = 4·dy + dx) and the place's offsets, as integers
+/// and as floats: tables, so a packet's pixel rows are whole-row additions. (Split out of
+/// `slot` lane by lane, they were 5 % of a sphere_light `light` pass.)
+#[derive(Clone, Copy)]
+struct Places {
+    slot: [u8; LANES],
+    dx: [u32; LANES],
+    dy: [u32; LANES],
+    fx: [f32; LANES],
+    fy: [f32; LANES],
+}
+
+impl Places {
+    const fn of(slot: [u8; LANES]) -> Places {
+        let mut p = Places {
+            slot,
+            dx: [0; LANES],
+            dy: [0; LANES],
+            fx: [0.0; LANES],
+            fy: [0.0; LANES],
+        };
+        let mut lane = 0;
+        while lane < LANES {
+            let s = slot[lane] as u32;
+            p.dx[lane] = s % TILE;
+            p.dy[lane] = s / TILE;
+            p.fx[lane] = (s % TILE) as f32;
+            p.fy[lane] = (s / TILE) as f32;
+            lane += 1;
+        }
+        p
+    }
+}
+
+/// A whole tile, lane = 4·dy + dx (the film's order within a tile).
+static TILE_PLACES: Places = {
+    let mut slot = [0u8; LANES];
+    let mut lane = 0;
+    while lane < LANES {
+        slot[lane] = lane as u8;
+        lane += 1;
+    }
+    Places::of(slot)
+};
+
 /// Tile `tile` of one pass: lane = 4·dy + dx, the film's order within a tile.
 fn tile_lanes(layout: &TileLayout, tile: usize, pass: u64) -> LaneSamples {
-    LaneSamples::new(
-        layout,
-        tile,
-        std::array::from_fn(|l| l as u8),
-        [pass; LANES],
-    )
+    LaneSamples::new(layout, tile, &TILE_PLACES, [pass; LANES])
 }
 
 /// Lanes' places in the tile (4·dy + dx) for each group size c = 2^shift and packet `block`
@@ -660,6 +703,22 @@ const BLOCK_SLOTS: [[[u8; LANES]; LANES]; 5] = {
     t
 };
 
+/// [`BLOCK_SLOTS`] as [`Places`].
+static BLOCK_PLACES: [[Places; LANES]; 5] = {
+    const EMPTY: Places = Places::of([0; LANES]);
+    let mut t = [[EMPTY; LANES]; 5];
+    let mut shift = 0;
+    while shift < 5 {
+        let mut block = 0;
+        while block < LANES {
+            t[shift][block] = Places::of(BLOCK_SLOTS[shift][block]);
+            block += 1;
+        }
+        shift += 1;
+    }
+    t
+};
+
 /// Pinhole camera ray through pixel (x, y) at sub-pixel offset `u` (a box filter).
 pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ray {
     let aspect = w as f32 / h as f32;
@@ -673,7 +732,6 @@ pub fn camera_ray(c: &Camera, w: u32, h: u32, x: u32, y: u32, u: [f32; 2]) -> Ra
 }
 
 /// A tile's pixel coordinates and camera sample numbers, per lane.
-#[derive(Default)]
 struct PixelLanes {
     x: [f32; LANES],
     y: [f32; LANES],
