@@ -10,6 +10,7 @@
 
 use crate::error::{Error, Result};
 use crate::film::{Accumulation, Film, TILE, TileLayout};
+use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
@@ -267,8 +268,11 @@ impl<'a> Renderer<'a> {
                             }
                             this.camera_phase(&layout, &samples, tile, scratch);
                             let got = this.shading_phase(tile, scratch);
+                            // Both indices are below 16 (c ≤ 16, slots of a 4×4 tile); the
+                            // masks say so, so the copy has no bounds checks.
                             for (lane, &slot) in samples.places.slot.iter().enumerate() {
-                                radiance[lane & (c - 1)][slot as usize] = got[lane];
+                                radiance[lane & (c - 1) & (LANES - 1)]
+                                    [slot as usize & (LANES - 1)] = got[lane];
                             }
                         }
                         for (u, x) in update.iter().zip(&radiance) {
@@ -361,14 +365,29 @@ impl<'a> Renderer<'a> {
         // (computed lane by lane: spheres are few). Lanes that did not hit get finite values
         // no one reads.
         g.given = 0;
-        match shared.filter(|&prim| world.geometry.sphere_index(prim as u32).is_none()) {
-            Some(prim) => {
+        let shared_sphere = shared.and_then(|prim| world.geometry.sphere_index(prim as u32));
+        match (shared, shared_sphere) {
+            (Some(prim), None) => {
                 let t = &world.geometry.triangles[prim];
                 g.v = [Soa3::splat(t.v0), Soa3::splat(t.v1), Soa3::splat(t.v2)];
                 (g.b1, g.b2) = (hits.u, hits.v);
                 g.ng = Soa3::splat(world.triangle_normals[prim]);
             }
-            None => {
+            (Some(_), Some(s)) => {
+                // One sphere for every hit lane (one pixel's samples on a sphere light or a
+                // ball): its points over lanes.
+                simd::run(
+                    self.isa,
+                    SphereHits {
+                        sphere: &world.geometry.spheres[s],
+                        cam,
+                        t: &hits.t,
+                        mask: hit_mask,
+                        g,
+                    },
+                );
+            }
+            (None, _) => {
                 let mut rest = hit_mask;
                 while rest != 0 {
                     let lane = rest.trailing_zeros() as usize;
@@ -790,6 +809,41 @@ struct HitLanes {
     p: Soa3,
     p_error: Soa3,
     given: u32,
+}
+
+/// [`World::surface`]'s point, error bound and normal for the lanes of `mask`, which hit
+/// `sphere`, over lanes (bit for bit: [`Sphere::surface_lanes`]); marked as given.
+///
+/// [`World::surface`]: crate::prepare::World::surface
+struct SphereHits<'a> {
+    sphere: &'a Sphere,
+    cam: &'a RayPacket,
+    t: &'a [f32; LANES],
+    mask: u32,
+    g: &'a mut HitLanes,
+}
+
+impl simd::Kernel for SphereHits<'_> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let (cam, g, m) = (self.cam, self.g, self.mask);
+        let o = V3::<L::V> {
+            x: L::V::load(&cam.ox),
+            y: L::V::load(&cam.oy),
+            z: L::V::load(&cam.oz),
+        };
+        let d = V3::<L::V> {
+            x: L::V::load(&cam.dx),
+            y: L::V::load(&cam.dy),
+            z: L::V::load(&cam.dz),
+        };
+        let [p, p_error, ng] = self.sphere.surface_lanes(o, d, L::V::load(self.t));
+        V3::select(m, p, V3::load(&g.p)).store(&mut g.p);
+        V3::select(m, p_error, V3::load(&g.p_error)).store(&mut g.p_error);
+        V3::select(m, ng, V3::load(&g.ng)).store(&mut g.ng);
+        g.given |= m;
+    }
 }
 
 /// Hit points, their error bounds and their shading geometry over lanes, written into the

@@ -2,7 +2,7 @@
 //! samples, never a tessellation, or light and geometry would disagree.
 
 use super::Ray;
-use crate::simd::{Vector64, WIDTH, dot3};
+use crate::simd::{V3, Vector, Vector64, WIDTH, dot3};
 use crate::tracer::RayPacket;
 use glam::Vec3;
 
@@ -118,6 +118,22 @@ impl Sphere {
     /// Projects a point computed from a ray back onto the surface, removing the error in t.
     pub fn project(&self, p: Vec3) -> Vec3 {
         self.center + (p - self.center).normalize() * self.radius
+    }
+
+    /// The hit point, its error bound and the normal of rays `o + t·d` that hit the sphere,
+    /// over lanes: [`Self::project`] of [`Ray::at`], [`Self::point_error`] and
+    /// [`Self::normal_at`] in the same operations and order, so bit for bit the scalar
+    /// values (what `World::surface` gives a sphere hit).
+    #[inline(always)]
+    pub fn surface_lanes<V: Vector<WIDTH>>(&self, o: V3<V>, d: V3<V>, t: V) -> [V3<V>; 3] {
+        use crate::math::gamma;
+        let c = V3::splat(self.center);
+        let r = V::splat(self.radius);
+        let off = (o + d.scale(t)) - c;
+        let p = c + off.scale(V::splat(1.0).div(off.dot(off).sqrt())).scale(r);
+        let centre_error = V3::splat(gamma(1) * self.center.abs());
+        let p_error = (p - c).abs().scale(V::splat(gamma(6))) + centre_error;
+        [p, p_error, (p - c) / r]
     }
 
     /// Absolute error bound of a point on the surface computed as centre + r·n̂ (by
