@@ -83,6 +83,10 @@ impl Sphere {
         let zero = D::splat(0.0);
         let disc = r2.sub(dot3(perp, perp));
         let mut hit = m & !disc.lt(zero);
+        if hit == 0 {
+            // Every lane misses (most shadow rays pass a sphere by): nothing more to compute.
+            return (0, [0.0; WIDTH]);
+        }
         let c = dot3(f, f).sub(r2);
         // b.signum(): −1 where the sign bit is set (−0.0 included).
         let sign = D::select(b.sign(), D::splat(-1.0), D::splat(1.0));
@@ -91,22 +95,16 @@ impl Sphere {
         let x = c.div(D::select(hit, q, D::splat(1.0)));
         let near = x.lt(q);
         let (t0, t1) = (D::select(near, x, q), D::select(near, q, x));
-        let mut tm = [0.0f64; WIDTH];
-        for i in 0..WIDTH {
-            tm[i] = tmax[i] as f64;
-        }
-        let tm = D::from_f64(&tm);
+        // f32 → f64 is exact, so comparisons in f64 are the f32 ones.
+        let tm = D::from_f32(tmax);
         let first = zero.lt(t0) & t0.lt(tm);
         let second = zero.lt(t1) & t1.lt(tm);
         hit &= first | second;
         let mut t = [0.0f32; WIDTH];
         D::select(first, t0, t1).to_f32(&mut t);
-        for (i, &t32) in t.iter().enumerate() {
-            // Rounding to f32 must not carry a hit past tmax or down to 0.
-            if !(t32 > 0.0 && t32 < tmax[i]) {
-                hit &= !(1 << i);
-            }
-        }
+        // Rounding to f32 must not carry a hit past tmax or down to 0.
+        let t32 = D::from_f32(&t);
+        hit &= zero.lt(t32) & t32.lt(tm);
         (hit, t)
     }
 
@@ -177,16 +175,23 @@ mod tests {
         for round in 0..2000 {
             let mut rays = RayPacket::default();
             let mut tmax = [0.0f32; WIDTH];
+            // Every tenth packet misses in every lane (lines passing the sphere by: from 1 or
+            // more away from the centre, at right angles to it, radius 0.7), the kernel's early
+            // exit.
+            let away = round % 10 == 9;
             for (l, tmax_l) in tmax.iter_mut().enumerate() {
                 let n = sample_uniform_sphere(rng.next_2d());
                 let o = match (round + l) % 5 {
+                    _ if away => s.center + n * (1.0 + 4.0 * rng.next_1d()),
                     0 => s.center + n * (s.radius + 1e-6),
                     1 => s.center + n * (s.radius - 1e-6),
                     2 => s.center + n * 0.3,
                     _ => s.center + n * (1.0 + 4.0 * rng.next_1d()),
                 };
                 let mut d = sample_uniform_sphere(rng.next_2d());
-                if l == 7 {
+                if away {
+                    d = n.any_orthonormal_vector();
+                } else if l == 7 {
                     // Perpendicular to the centre direction: f·d = 0.
                     let f = (o - s.center).normalize();
                     d = f.any_orthonormal_vector();
