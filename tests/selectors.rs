@@ -14,8 +14,9 @@ use dibench::lights::selector::LightSelector;
 use dibench::lights::selector::bvh::LightBvh;
 use dibench::lights::selector::bvh_split::SPLIT;
 use dibench::lights::selector::exhaustive::Exhaustive;
-use dibench::lights::{Light, LightCtx};
+use dibench::lights::{LaneQuery, Light, LightCtx};
 use dibench::strategy::ShadingPoint;
+use dibench::tracer::LANES;
 use glam::Vec3;
 use selectors_common::{Rng, Spec, contexts, lights, mixed, quad, selectors};
 
@@ -109,6 +110,86 @@ fn a_constant_choice_is_what_sample_returns() {
     }
     let power = (dibench::lights::selector::power::POWER.build)(&one).unwrap();
     let e = consistency(&Halved(power), 1, &ctxs, 13).unwrap_err();
+    eprintln!("caught: {e}");
+}
+
+/// `sample_lanes` of a packet's lanes (some masked off) picks, lane by lane, what `sample`
+/// picks from that lane's point with that lane's number, and leaves the other lanes alone.
+fn lanes_agree(sel: &dyn LightSelector, ctxs: &[LightCtx], seed: u64) -> Result<(), String> {
+    let mut r = Rng::new(seed);
+    for (k, group) in ctxs.chunks(LANES).enumerate() {
+        let mut q = LaneQuery::default();
+        let mut u = [0.0f64; LANES];
+        for (lane, ctx) in group.iter().enumerate() {
+            q.p.set(lane, ctx.p);
+            q.n.set(lane, ctx.n);
+            u[lane] = r.u64();
+        }
+        let full = (1u32 << group.len()) - 1;
+        // Every third packet with some lanes off.
+        let mask = if k % 3 == 2 { full & 0x5a5a } else { full };
+        let (mut light, mut pmf) = ([usize::MAX; LANES], [-1.0f32; LANES]);
+        let picked = sel.sample_lanes(&q, &u, mask, &mut light, &mut pmf);
+        for lane in 0..LANES {
+            let want = (mask >> lane & 1 != 0)
+                .then(|| sel.sample(&q.ctx(lane), u[lane]))
+                .flatten();
+            let got = (picked >> lane & 1 != 0).then_some((light[lane], pmf[lane]));
+            if got.map(|(i, p)| (i, p.to_bits())) != want.map(|(i, p)| (i, p.to_bits())) {
+                return Err(format!(
+                    "packet {k} lane {lane}: lanes {got:?}, sample {want:?}"
+                ));
+            }
+            if picked >> lane & 1 == 0 && (light[lane], pmf[lane]) != (usize::MAX, -1.0) {
+                return Err(format!(
+                    "packet {k} lane {lane}: an unpicked lane was written"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every selector's packet call is its lane-by-lane call (the light estimators ask for a
+/// packet's lanes at once). Negative control: a packet call whose lanes take their
+/// neighbours' numbers.
+#[test]
+fn sample_lanes_is_sample_lane_by_lane() {
+    let ctxs = contexts(8, 320);
+    for (set, specs) in [
+        ("local", mixed(6, 40, false)),
+        ("distant too", mixed(7, 40, true)),
+    ] {
+        let lights = lights(&specs);
+        for (name, sel) in selectors(&lights) {
+            if let Err(e) = lanes_agree(sel.as_ref(), &ctxs, 21) {
+                panic!("{name} on {set}: {e}");
+            }
+        }
+    }
+    struct Shifted(Box<dyn LightSelector>);
+    impl LightSelector for Shifted {
+        fn sample(&self, ctx: &LightCtx, u: f64) -> Option<(usize, f32)> {
+            self.0.sample(ctx, u)
+        }
+        fn pmf(&self, ctx: &LightCtx, light: usize) -> f32 {
+            self.0.pmf(ctx, light)
+        }
+        fn sample_lanes(
+            &self,
+            q: &LaneQuery,
+            u: &[f64; LANES],
+            mask: u32,
+            light: &mut [usize; LANES],
+            pmf: &mut [f32; LANES],
+        ) -> u32 {
+            let shifted: [f64; LANES] = std::array::from_fn(|l| u[(l + 1) % LANES]);
+            self.0.sample_lanes(q, &shifted, mask, light, pmf)
+        }
+    }
+    let lights = lights(&mixed(6, 40, false));
+    let power = (dibench::lights::selector::power::POWER.build)(&lights).unwrap();
+    let e = lanes_agree(&Shifted(power), &ctxs, 21).unwrap_err();
     eprintln!("caught: {e}");
 }
 

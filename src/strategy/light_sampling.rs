@@ -434,22 +434,13 @@ impl<'s> BoundLights<'s> {
             *light = [i; LANES];
             x.pmf = [pmf; WIDTH];
         } else {
-            let mut c = 0u32;
-            let mut rest = packet.mask;
-            while rest != 0 {
-                let lane = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                let Some((i, pmf)) = self
-                    .selector
-                    .sample(&q.ctx(lane), selection_number(u_select[lane], u2[lane]))
-                else {
-                    continue;
-                };
-                light[lane] = i;
-                x.pmf[lane] = pmf;
-                c |= 1 << lane;
+            let mut numbers = [0.0f64; LANES];
+            for (n, (&hi, &lo)) in numbers.iter_mut().zip(u_select.iter().zip(u2.iter())) {
+                *n = selection_number(hi, lo);
             }
-            chosen = c;
+            chosen = self
+                .selector
+                .sample_lanes(&q, &numbers, packet.mask, light, &mut x.pmf);
         }
         // Lights with a kernel over lanes of different lights (mesh triangles, spheres, quads) hand
         // over their records; each such kernel samples all its lanes at once. One light for

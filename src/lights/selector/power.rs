@@ -4,7 +4,8 @@
 //! Vose 1991) makes it O(1) per sample.
 
 use super::{LightSelector, SelectorType};
-use crate::lights::LightCtx;
+use crate::lights::{LaneQuery, LightCtx};
+use crate::simd::WIDTH as LANES;
 use crate::sampling::discrete::AliasTable;
 
 pub static POWER: SelectorType = SelectorType {
@@ -28,6 +29,25 @@ impl LightSelector for PowerSelector {
 
     fn pmf(&self, _ctx: &LightCtx, light: usize) -> f32 {
         self.0.pmf(light)
+    }
+
+    /// The point plays no part: one loop over the lanes' numbers.
+    fn sample_lanes(
+        &self,
+        _q: &LaneQuery,
+        u: &[f64; LANES],
+        mask: u32,
+        light: &mut [usize; LANES],
+        pmf: &mut [f32; LANES],
+    ) -> u32 {
+        let mut rest = mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let i = self.0.sample(u[lane]);
+            (light[lane], pmf[lane]) = (i, self.0.pmf(i));
+        }
+        mask
     }
 
     /// One light: the table's only bin, kept whole (q = 1), whatever u is.

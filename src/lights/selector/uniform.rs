@@ -2,7 +2,8 @@
 //! per-emitter weights): the baseline that knows nothing.
 
 use super::{LightSelector, SelectorType};
-use crate::lights::LightCtx;
+use crate::lights::{LaneQuery, LightCtx};
+use crate::simd::WIDTH as LANES;
 
 pub static UNIFORM: SelectorType = SelectorType {
     name: "uniform",
@@ -23,12 +24,29 @@ pub struct UniformSelector {
 
 impl LightSelector for UniformSelector {
     fn sample(&self, _ctx: &LightCtx, u: f64) -> Option<(usize, f32)> {
-        let i = ((u * self.n as f64) as usize).min(self.n - 1);
-        Some((i, self.p()))
+        Some((self.index(u), self.p()))
     }
 
     fn pmf(&self, _ctx: &LightCtx, _light: usize) -> f32 {
         self.p()
+    }
+
+    /// The point plays no part: one loop over the lanes' numbers.
+    fn sample_lanes(
+        &self,
+        _q: &LaneQuery,
+        u: &[f64; LANES],
+        mask: u32,
+        light: &mut [usize; LANES],
+        pmf: &mut [f32; LANES],
+    ) -> u32 {
+        let mut rest = mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            (light[lane], pmf[lane]) = (self.index(u[lane]), self.p());
+        }
+        mask
     }
 
     fn constant(&self) -> Option<(usize, f32)> {
@@ -37,6 +55,11 @@ impl LightSelector for UniformSelector {
 }
 
 impl UniformSelector {
+    /// The light that number u picks: what `sample` and `sample_lanes` return.
+    fn index(&self, u: f64) -> usize {
+        ((u * self.n as f64) as usize).min(self.n - 1)
+    }
+
     /// Every light's probability, the one number `sample`, `pmf` and `constant` report.
     fn p(&self) -> f32 {
         (1.0 / self.n as f64) as f32
