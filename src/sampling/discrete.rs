@@ -157,11 +157,10 @@ impl AliasTable {
         let x = u * self.bins.len() as f64;
         let i = (x as usize).min(self.bins.len() - 1);
         let b = &self.bins[i];
-        if x - (i as f64) < b.q {
-            i
-        } else {
-            b.alias as usize
-        }
+        // Without a branch: whether a bin keeps its index is a coin flip of bias q, which a
+        // branch predictor cannot learn (as a branch it was half a mesh_light `light`
+        // pass's light selection).
+        std::hint::select_unpredictable(x - (i as f64) < b.q, i, b.alias as usize)
     }
 
     /// The probability [`Self::sample`] returns i for u uniform on [0, 1), from the table
