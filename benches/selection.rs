@@ -78,6 +78,23 @@ fn selection(c: &mut Criterion) {
                     }
                 })
             });
+            // The same queries with new numbers every iteration, as a render draws them: the
+            // 1,024 fixed numbers above repeat, so a branch predictor learns choices a render
+            // cannot (the alias table's keep-or-alias step). For the point-free selectors,
+            // where that step is most of the cost.
+            if matches!(kind.name, "power" | "uniform") {
+                group.bench_function(format!("{}-fresh", kind.name), |b| {
+                    // Shifted by the golden ratio's fraction each iteration (a Weyl sequence):
+                    // uniform, never repeating.
+                    let mut shift = 0.0f64;
+                    b.iter(|| {
+                        shift = (shift + 0.618_033_988_749_894_9).fract();
+                        for (ctx, u) in &queries {
+                            black_box(sel.sample(black_box(ctx), (*u + shift).fract()));
+                        }
+                    })
+                });
+            }
         }
         group.finish();
     }
