@@ -828,17 +828,11 @@ impl simd::Kernel for SphereHits<'_> {
     #[inline(always)]
     fn run<L: Lanes>(self) {
         let (cam, g, m) = (self.cam, self.g, self.mask);
-        let o = V3::<L::V> {
-            x: L::V::load(&cam.ox),
-            y: L::V::load(&cam.oy),
-            z: L::V::load(&cam.oz),
-        };
-        let d = V3::<L::V> {
-            x: L::V::load(&cam.dx),
-            y: L::V::load(&cam.dy),
-            z: L::V::load(&cam.dz),
-        };
-        let [p, p_error, ng] = self.sphere.surface_lanes(o, d, L::V::load(self.t));
+        let [p, p_error, ng] = self.sphere.surface_lanes(
+            cam.origin_lanes::<L::V>(),
+            cam.dir_lanes(),
+            L::V::load(self.t),
+        );
         V3::select(m, p, V3::load(&g.p)).store(&mut g.p);
         V3::select(m, p_error, V3::load(&g.p_error)).store(&mut g.p_error);
         V3::select(m, ng, V3::load(&g.ng)).store(&mut g.ng);
@@ -869,12 +863,7 @@ impl simd::Kernel for ShadingKernel<'_> {
         let (tp, terr) = Triangle::point_lanes(v, L::V::load(&g.b1), L::V::load(&g.b2));
         let p = V3::select(g.given, V3::load(&g.p), tp);
         let p_error = V3::select(g.given, V3::load(&g.p_error), terr);
-        let dir = V3 {
-            x: L::V::load(&cam.dx),
-            y: L::V::load(&cam.dy),
-            z: L::V::load(&cam.dz),
-        };
-        ShadingLanes::compute(p, p_error, V3::load(&g.ng), dir, self.geo);
+        ShadingLanes::compute(p, p_error, V3::load(&g.ng), cam.dir_lanes(), self.geo);
         p.store(self.p);
         p_error.store(self.p_error);
     }

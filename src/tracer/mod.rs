@@ -11,6 +11,7 @@ pub mod packet;
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Hit, Ray};
+use crate::simd::{V3, Vector};
 use glam::Vec3;
 
 /// Rays per packet: one 4×4 pixel tile, one 16-lane vector of the SIMD layer.
@@ -38,6 +39,28 @@ pub struct RayPacket {
     pub dy: [f32; LANES],
     pub dz: [f32; LANES],
     pub tmax: [f32; LANES],
+}
+
+impl RayPacket {
+    /// The origins over lanes (for kernels).
+    #[inline(always)]
+    pub fn origin_lanes<V: Vector<LANES>>(&self) -> V3<V> {
+        V3 {
+            x: V::load(&self.ox),
+            y: V::load(&self.oy),
+            z: V::load(&self.oz),
+        }
+    }
+
+    /// The directions over lanes (for kernels).
+    #[inline(always)]
+    pub fn dir_lanes<V: Vector<LANES>>(&self) -> V3<V> {
+        V3 {
+            x: V::load(&self.dx),
+            y: V::load(&self.dy),
+            z: V::load(&self.dz),
+        }
+    }
 }
 
 impl Default for RayPacket {

@@ -52,6 +52,24 @@ pub trait LightSelector: Send + Sync {
     }
 }
 
+/// [`LightSelector::sample_lanes`] of a selector that ignores the point (power, uniform):
+/// `pick(u)` for each lane of `mask`, every one of which picks a light.
+pub(crate) fn point_free_lanes(
+    u: &[f64; LANES],
+    mask: u32,
+    light: &mut [usize; LANES],
+    pmf: &mut [f32; LANES],
+    pick: impl Fn(f64) -> (usize, f32),
+) -> u32 {
+    let mut rest = mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        (light[lane], pmf[lane]) = pick(u[lane]);
+    }
+    mask
+}
+
 /// Builds a selector over a scene's lights, or says why it cannot select among them.
 pub type BuildSelector = fn(&[Box<dyn Light>]) -> Result<Box<dyn LightSelector>, String>;
 

@@ -3,7 +3,7 @@
 //! light equally and poor for many lights of which few are near. An alias table (Walker 1977,
 //! Vose 1991) makes it O(1) per sample.
 
-use super::{LightSelector, SelectorType};
+use super::{LightSelector, SelectorType, point_free_lanes};
 use crate::lights::{LaneQuery, LightCtx};
 use crate::simd::WIDTH as LANES;
 use crate::sampling::discrete::AliasTable;
@@ -21,10 +21,17 @@ pub static POWER: SelectorType = SelectorType {
 
 pub struct PowerSelector(pub AliasTable);
 
+impl PowerSelector {
+    /// The light number u picks and its probability: what `sample` and `sample_lanes` return.
+    fn pick(&self, u: f64) -> (usize, f32) {
+        let i = self.0.sample(u);
+        (i, self.0.pmf(i))
+    }
+}
+
 impl LightSelector for PowerSelector {
     fn sample(&self, _ctx: &LightCtx, u: f64) -> Option<(usize, f32)> {
-        let i = self.0.sample(u);
-        Some((i, self.0.pmf(i)))
+        Some(self.pick(u))
     }
 
     fn pmf(&self, _ctx: &LightCtx, light: usize) -> f32 {
@@ -40,14 +47,7 @@ impl LightSelector for PowerSelector {
         light: &mut [usize; LANES],
         pmf: &mut [f32; LANES],
     ) -> u32 {
-        let mut rest = mask;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            let i = self.0.sample(u[lane]);
-            (light[lane], pmf[lane]) = (i, self.0.pmf(i));
-        }
-        mask
+        point_free_lanes(u, mask, light, pmf, |u| self.pick(u))
     }
 
     /// One light: the table's only bin, kept whole (q = 1), whatever u is.

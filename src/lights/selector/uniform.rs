@@ -1,7 +1,7 @@
 //! Every light equally likely (pbrt-v4 `UniformLightSampler`; Mitsuba 3's only choice before
 //! per-emitter weights): the baseline that knows nothing.
 
-use super::{LightSelector, SelectorType};
+use super::{LightSelector, SelectorType, point_free_lanes};
 use crate::lights::{LaneQuery, LightCtx};
 use crate::simd::WIDTH as LANES;
 
@@ -40,13 +40,7 @@ impl LightSelector for UniformSelector {
         light: &mut [usize; LANES],
         pmf: &mut [f32; LANES],
     ) -> u32 {
-        let mut rest = mask;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            (light[lane], pmf[lane]) = (self.index(u[lane]), self.p());
-        }
-        mask
+        point_free_lanes(u, mask, light, pmf, |u| (self.index(u), self.p()))
     }
 
     fn constant(&self) -> Option<(usize, f32)> {
