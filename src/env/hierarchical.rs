@@ -160,24 +160,11 @@ impl HierarchicalWarp {
     }
 }
 
-/// The quads `quads[at[i]]` of N lanes as four vectors, one per texel of the quad. A
-/// function, not a closure: a closure is not always inlined into the ISA's entry, and outside
-/// it its vector load is a call.
+/// The quads `quads[at[i]]` of N lanes as four vectors, one per texel of the quad
+/// ([`Vector::load_records`]: each quad read whole, transposed in registers).
 #[inline(always)]
 fn gather<V: Vector<N>, const N: usize>(quads: &[[f32; 4]], at: &[usize; N]) -> [V; 4] {
-    let mut a = [[0.0f32; N]; 4];
-    for i in 0..N {
-        let q = quads[at[i]];
-        for k in 0..4 {
-            a[k][i] = q[k];
-        }
-    }
-    [
-        V::load(&a[0]),
-        V::load(&a[1]),
-        V::load(&a[2]),
-        V::load(&a[3]),
-    ]
+    V::load_records(&std::array::from_fn(|i| &quads[at[i]]))
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in

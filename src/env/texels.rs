@@ -325,18 +325,13 @@ impl ImportanceMap {
         let (x, y, z) = latlong::uv_to_dir_lanes(u, v);
         let mut out = EnvLanes::default();
         V3 { x, y, z }.store(&mut out.wi);
-        let mut density = [0.0f32; WIDTH];
-        let mut positive = 0u32;
-        for i in 0..WIDTH {
-            let [r, g, b, d] = self.record[k[i]];
-            out.radiance.set(i, Vec3::new(r, g, b));
-            density[i] = d;
-            // As the scalar sampler's weight > 0 (see `record`).
-            positive |= ((d > 0.0) as u32) << i;
-        }
+        let [r, g, b, density] = V::load_records(&std::array::from_fn(|i| &self.record[k[i]]));
+        V3 { x: r, y: g, z: b }.store(&mut out.radiance);
         let zero = V::splat(0.0);
+        // As the scalar sampler's weight > 0 (see `record`).
+        let positive = zero.lt(density);
         out.valid = active & positive & !jac.le(zero);
-        V::load(&density).div(jac).store(&mut out.pdf);
+        density.div(jac).store(&mut out.pdf);
         Some(out)
     }
 

@@ -151,6 +151,27 @@ impl Vector<NARROW> for Y {
     fn trunc_u32(self, a: &mut [u32; NARROW]) {
         unsafe { _mm256_storeu_si256(a.as_mut_ptr() as *mut __m256i, _mm256_cvttps_epi32(self.0)) }
     }
+    #[inline(always)]
+    fn load_records(rows: &[&[f32; 4]; NARROW]) -> [Self; 4] {
+        unsafe {
+            // r[j]'s 128-bit half b is the record of lane 4b + j; a 4×4 transpose within each
+            // half then gives component k of lanes 4b..4b + 3 in half b of vector k.
+            let q = |i: usize| _mm_loadu_ps(rows[i].as_ptr());
+            let r: [__m256; 4] = std::array::from_fn(|j| {
+                _mm256_insertf128_ps::<1>(_mm256_castps128_ps256(q(j)), q(4 + j))
+            });
+            let t0 = _mm256_castps_pd(_mm256_unpacklo_ps(r[0], r[1]));
+            let t1 = _mm256_castps_pd(_mm256_unpackhi_ps(r[0], r[1]));
+            let t2 = _mm256_castps_pd(_mm256_unpacklo_ps(r[2], r[3]));
+            let t3 = _mm256_castps_pd(_mm256_unpackhi_ps(r[2], r[3]));
+            [
+                Y(_mm256_castpd_ps(_mm256_unpacklo_pd(t0, t2))),
+                Y(_mm256_castpd_ps(_mm256_unpackhi_pd(t0, t2))),
+                Y(_mm256_castpd_ps(_mm256_unpacklo_pd(t1, t3))),
+                Y(_mm256_castpd_ps(_mm256_unpackhi_pd(t1, t3))),
+            ]
+        }
+    }
 }
 
 macro_rules! both {
@@ -236,6 +257,12 @@ impl Vector<WIDTH> for Y2 {
         let (lo, hi) = a.split_at_mut(NARROW);
         self.0.trunc_u32(lo.try_into().expect("8 lanes"));
         self.1.trunc_u32(hi.try_into().expect("8 lanes"));
+    }
+    #[inline(always)]
+    fn load_records(rows: &[&[f32; 4]; WIDTH]) -> [Self; 4] {
+        let lo = Y::load_records(rows[..NARROW].try_into().expect("8 lanes"));
+        let hi = Y::load_records(rows[NARROW..].try_into().expect("8 lanes"));
+        std::array::from_fn(|k| Y2(lo[k], hi[k]))
     }
 }
 

@@ -135,6 +135,30 @@ impl Vector<WIDTH> for Z {
     fn trunc_u32(self, a: &mut [u32; WIDTH]) {
         unsafe { _mm512_storeu_si512(a.as_mut_ptr() as *mut _, _mm512_cvttps_epi32(self.0)) }
     }
+    #[inline(always)]
+    fn load_records(rows: &[&[f32; 4]; WIDTH]) -> [Self; 4] {
+        unsafe {
+            // r[j]'s 128-bit block b is the record of lane 4b + j; a 4×4 transpose within
+            // each block then gives component k of lanes 4b..4b + 3 in block b of vector k.
+            let q = |i: usize| _mm_loadu_ps(rows[i].as_ptr());
+            let r: [__m512; 4] = std::array::from_fn(|j| {
+                let v = _mm512_castps128_ps512(q(j));
+                let v = _mm512_insertf32x4::<1>(v, q(4 + j));
+                let v = _mm512_insertf32x4::<2>(v, q(8 + j));
+                _mm512_insertf32x4::<3>(v, q(12 + j))
+            });
+            let t0 = _mm512_castps_pd(_mm512_unpacklo_ps(r[0], r[1]));
+            let t1 = _mm512_castps_pd(_mm512_unpackhi_ps(r[0], r[1]));
+            let t2 = _mm512_castps_pd(_mm512_unpacklo_ps(r[2], r[3]));
+            let t3 = _mm512_castps_pd(_mm512_unpackhi_ps(r[2], r[3]));
+            [
+                Z(_mm512_castpd_ps(_mm512_unpacklo_pd(t0, t2))),
+                Z(_mm512_castpd_ps(_mm512_unpackhi_pd(t0, t2))),
+                Z(_mm512_castpd_ps(_mm512_unpacklo_pd(t1, t3))),
+                Z(_mm512_castpd_ps(_mm512_unpackhi_pd(t1, t3))),
+            ]
+        }
+    }
 }
 
 /// Sign bits of 16 lanes (avx512f has no movmskps for zmm: compare as integers against 0).

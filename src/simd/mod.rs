@@ -63,6 +63,26 @@ pub trait Vector<const N: usize>: Copy {
     /// Each lane truncated toward zero, as `x as u32`, for lanes in [0, 2³¹) (the caller
     /// clamps: outside that range the ISAs differ).
     fn trunc_u32(self, a: &mut [u32; N]);
+    /// Lane i's four-float record `rows[i]`, transposed: vector k holds component k of every
+    /// lane's record (an array of 16-byte structures read as a structure of arrays). The
+    /// 16- and 8-lane vectors load each record whole and transpose in registers: written
+    /// lane by lane into an array and loaded back, the lanes' 4·N stores stall the loads
+    /// (no store-to-load forwarding from many stores into one load).
+    #[inline(always)]
+    fn load_records(rows: &[&[f32; 4]; N]) -> [Self; 4] {
+        let mut a = [[0.0f32; N]; 4];
+        for i in 0..N {
+            for k in 0..4 {
+                a[k][i] = rows[i][k];
+            }
+        }
+        [
+            Self::load(&a[0]),
+            Self::load(&a[1]),
+            Self::load(&a[2]),
+            Self::load(&a[3]),
+        ]
+    }
 }
 
 /// An f64 vector of `N` lanes, for the sample-path code whose numerics need f64 (sphere cones,
@@ -285,6 +305,49 @@ mod tests {
                     assert_eq!(x, y, "{isa:?}");
                 }
                 assert_eq!(g.1, w.1, "{isa:?}");
+            }
+        }
+    }
+
+    struct Records<'a>(&'a [[f32; 4]], [usize; WIDTH]);
+
+    impl Kernel for Records<'_> {
+        type Out = ([[f32; WIDTH]; 4], [[f32; NARROW]; 4]);
+        fn run<L: Lanes>(self) -> Self::Out {
+            let rows: [&[f32; 4]; WIDTH] = std::array::from_fn(|i| &self.0[self.1[i]]);
+            let narrow: [&[f32; 4]; NARROW] = std::array::from_fn(|i| rows[WIDTH - 1 - i]);
+            let (mut w, mut n) = ([[0.0; WIDTH]; 4], [[0.0; NARROW]; 4]);
+            for (k, v) in L::V::load_records(&rows).into_iter().enumerate() {
+                v.store(&mut w[k]);
+            }
+            for (k, v) in L::W::load_records(&narrow).into_iter().enumerate() {
+                v.store(&mut n[k]);
+            }
+            (w, n)
+        }
+    }
+
+    /// Records read over lanes are each lane's record, component by component, at both
+    /// widths on every ISA (lanes reading the same record among them). Control: the scalar
+    /// formula's answer is checked directly, so a transposition that swaps lanes or
+    /// components (the ISAs' shuffles) fails here.
+    #[test]
+    fn records_over_lanes_are_each_lanes_record() {
+        let table: Vec<[f32; 4]> = (0..40)
+            .map(|r| std::array::from_fn(|k| r as f32 + 0.25 * k as f32))
+            .collect();
+        let mut at: [usize; WIDTH] = std::array::from_fn(|i| (i * 7 + 3) % 40);
+        at[9] = at[2];
+        for isa in Isa::available() {
+            let (w, n) = run(isa, Records(&table, at));
+            for k in 0..4 {
+                for i in 0..WIDTH {
+                    assert_eq!(w[k][i].to_bits(), table[at[i]][k].to_bits(), "{isa:?}");
+                }
+                for i in 0..NARROW {
+                    let want = table[at[WIDTH - 1 - i]][k];
+                    assert_eq!(n[k][i].to_bits(), want.to_bits(), "{isa:?}");
+                }
             }
         }
     }
