@@ -24,13 +24,20 @@ pub struct HierarchicalWarp {
     /// Cumulative tile sums, starting at 0 (tiles + 1 entries, non-decreasing).
     tile_cdf: Vec<f32>,
     /// Per tile, the levels of side 2, 4, …, n, coarsest first, each as the 2×2 quads of its
-    /// parent level's nodes in row-major order, a quad's texels as (x, y) = (0, 0), (1, 0),
-    /// (0, 1), (1, 1): a descent step reads one quad, 16 bytes in one cache line, where a
-    /// row-major level spread the four over two rows. Tile t's levels start at quad t·`block`.
-    pyramid: Vec<[f32; 4]>,
-    /// Quads per tile: 1 + 4 + … + (n/2)².
+    /// parent level's nodes, a quad's texels as (x, y) = (0, 0), (1, 0), (0, 1), (1, 1). A
+    /// level's quads are in Morton (Z) order, so the quads of a node's four children are
+    /// one 64-byte line: a descent step reads one quad, and the line of the next step's
+    /// quad is known (and prefetched) before the step's splits are computed. Each level
+    /// starts on a line; tile t's levels start at line t·`block`.
+    pyramid: Vec<Line>,
+    /// Lines per tile.
     block: usize,
 }
+
+/// Four quads in one cache line.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+struct Line([[f32; 4]; 4]);
 
 /// The chosen atlas texels of N lanes, (column, row), and the offsets (du, dv) ∈ [0, 1)²
 /// inside them.
@@ -51,7 +58,8 @@ impl HierarchicalWarp {
             "hierarchical warping needs a power-of-two tile"
         );
         let width = tiles * n;
-        let block = (n * n - 1) / 3;
+        // One line for the root's quad (padded), then a quarter of each level's quads.
+        let block = if n > 1 { 1 + (n * n / 4 - 1) / 3 } else { 0 };
         let mut pyramid = Vec::with_capacity(tiles * block);
         let mut tile_cdf = vec![0.0f32];
         let mut running = 0.0f64;
@@ -83,7 +91,12 @@ impl HierarchicalWarp {
             running += levels.last().unwrap()[0];
             tile_cdf.push(running as f32);
             for level in levels.iter().rev().skip(1) {
-                pyramid.extend(quads(level));
+                let q = quads(level);
+                let mut lines = vec![Line::default(); q.len().div_ceil(4)];
+                for (m, quad) in q.into_iter().enumerate() {
+                    lines[m / 4].0[m % 4] = quad;
+                }
+                pyramid.extend(lines);
             }
         }
         (running > 0.0).then_some(HierarchicalWarp {
@@ -128,23 +141,38 @@ impl HierarchicalWarp {
                 .min(V::splat(ONE_MINUS_EPSILON));
         }
         let (mut x, mut y) = ([0u32; N], [0u32; N]);
-        // `half` is the parent level's side: the quad of node (x, y) is its row-major index.
-        let (mut half, mut offset) = (1usize, 0usize);
+        // `m` is the Morton index of the node whose quad this step reads, among the nodes of
+        // side `half` (the parent level's); `line` is its level's first line.
+        let mut m = [0usize; N];
+        let (mut half, mut line) = (1usize, 0usize);
         while half < self.n {
             let mut at = [0usize; N];
             for i in 0..N {
-                at[i] = tile[i] * self.block + offset + y[i] as usize * half + x[i] as usize;
+                at[i] = tile[i] * self.block + line + m[i] / 4;
             }
-            let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at);
+            // The next level's line for this node's children (whichever the splits choose).
+            let next = line + (half * half).div_ceil(4);
+            if 2 * half < self.n {
+                for i in 0..N {
+                    crate::simd::prefetch(
+                        self.pyramid
+                            .as_ptr()
+                            .wrapping_add(tile[i] * self.block + next + m[i]),
+                    );
+                }
+            }
+            let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at, &m);
             let (right, u0n) = split(c00.add(c01), c10.add(c11), u0);
             let (top, bottom) = (V::select(right, c10, c00), V::select(right, c11, c01));
             let (down, u1n) = split(top, bottom, u1);
             for i in 0..N {
-                x[i] = 2 * x[i] + (right >> i & 1);
-                y[i] = 2 * y[i] + (down >> i & 1);
+                let (r, d) = (right >> i & 1, down >> i & 1);
+                x[i] = 2 * x[i] + r;
+                y[i] = 2 * y[i] + d;
+                m[i] = 4 * m[i] + (r + 2 * d) as usize;
             }
             (u0, u1) = (u0n, u1n);
-            offset += half * half;
+            line = next;
             half *= 2;
         }
         let mut col = x;
@@ -160,27 +188,40 @@ impl HierarchicalWarp {
     }
 }
 
-/// The quads `quads[at[i]]` of N lanes as four vectors, one per texel of the quad
+/// Lane i's quad `m[i] % 4` of line `at[i]`, as four vectors, one per texel of the quad
 /// ([`Vector::load_records`]: each quad read whole, transposed in registers).
 #[inline(always)]
-fn gather<V: Vector<N>, const N: usize>(quads: &[[f32; 4]], at: &[usize; N]) -> [V; 4] {
-    V::load_records(&std::array::from_fn(|i| &quads[at[i]]))
+fn gather<V: Vector<N>, const N: usize>(lines: &[Line], at: &[usize; N], m: &[usize; N]) -> [V; 4] {
+    V::load_records(&std::array::from_fn(|i| &lines[at[i]].0[m[i] % 4]))
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in
-/// f32.
-fn quads(level: &[f64]) -> impl Iterator<Item = [f32; 4]> + '_ {
+/// f32, the parent nodes in Morton order (bits of x at even positions, of y at odd ones).
+fn quads(level: &[f64]) -> Vec<[f32; 4]> {
     let s = level.len().isqrt();
     let h = s / 2;
-    (0..h * h).map(move |k| {
-        let (x, y) = (2 * (k % h), 2 * (k / h));
-        [
-            level[y * s + x] as f32,
-            level[y * s + x + 1] as f32,
-            level[(y + 1) * s + x] as f32,
-            level[(y + 1) * s + x + 1] as f32,
-        ]
-    })
+    let mut out = vec![[0.0f32; 4]; h * h];
+    for py in 0..h {
+        for px in 0..h {
+            let (x, y) = (2 * px, 2 * py);
+            out[morton(px, py)] = [
+                level[y * s + x] as f32,
+                level[y * s + x + 1] as f32,
+                level[(y + 1) * s + x] as f32,
+                level[(y + 1) * s + x + 1] as f32,
+            ];
+        }
+    }
+    out
+}
+
+/// The Morton index of (x, y): bit b of x at bit 2b, bit b of y at bit 2b + 1.
+fn morton(x: usize, y: usize) -> usize {
+    let mut m = 0;
+    for b in 0..usize::BITS as usize / 2 {
+        m |= (x >> b & 1) << (2 * b) | (y >> b & 1) << (2 * b + 1);
+    }
+    m
 }
 
 /// Per lane, the second half (bit set) with probability b/(a + b), else the first, and u
@@ -259,21 +300,16 @@ mod tests {
         let (tiles, n) = (2, 4);
         let w = atlas(tiles, n);
         let warp = HierarchicalWarp::new(&w, tiles, n).unwrap();
-        let mut mirrored = warp.clone();
-        for t in 0..tiles {
-            let (mut half, mut off) = (1, t * warp.block);
-            while half < n {
-                // Each row of quads reversed, and each quad's columns swapped.
-                for row in mirrored.pyramid[off..off + half * half].chunks_exact_mut(half) {
-                    row.reverse();
-                    for q in row {
-                        *q = [q[1], q[0], q[3], q[2]];
-                    }
-                }
-                off += half * half;
-                half *= 2;
-            }
-        }
+        // Every level mirrored left-right within each tile: the warp of the mirrored atlas.
+        let width = tiles * n;
+        let flipped: Vec<f32> = (0..w.len())
+            .map(|k| {
+                let (x, y) = (k % width, k / width);
+                let (t, xt) = (x / n, x % n);
+                w[y * width + t * n + (n - 1 - xt)]
+            })
+            .collect();
+        let mirrored = HierarchicalWarp::new(&flipped, tiles, n).unwrap();
         assert!(frequency_mismatch(&mirrored, &w).is_some());
         let mut tile_off = warp.clone();
         tile_off.tile_cdf[1] *= 0.9;
