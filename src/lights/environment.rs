@@ -7,8 +7,8 @@ use super::{
     LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
     sample_lane_by_lane,
 };
-use crate::env::{EnvLanes, EnvMethod, EnvSampler, Environment, ImportanceMap, Repr};
-use crate::simd::{self, Isa, Kernel, Lanes, Soa3, Vector, WIDTH};
+use crate::env::{EnvMethod, EnvSampler, Environment, ImportanceMap, Repr};
+use crate::simd::{self, Isa, Kernel, Lanes, Soa3, V3, Vector};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -73,39 +73,40 @@ impl Light for EnvironmentLight {
         if m.env.repr != Repr::LatLong {
             return sample_lane_by_lane(self, q, active, m, out);
         }
-        struct LatLong<'a>(&'a ImportanceMap, EnvSampler, &'a LaneQuery, u32);
+        struct LatLong<'a>(
+            &'a ImportanceMap,
+            EnvSampler,
+            &'a LaneQuery,
+            u32,
+            &'a mut LaneSamples,
+        );
         impl Kernel for LatLong<'_> {
-            type Out = Option<EnvLanes>;
+            type Out = bool;
+            /// The lanes of `active` written whole rows at a time; false for a black map.
             #[inline(always)]
-            fn run<L: Lanes>(self) -> Option<EnvLanes> {
+            fn run<L: Lanes>(self) -> bool {
+                let (active, out) = (self.3, self.4);
                 let (u0, u1) = (L::V::load(&self.2.u[0]), L::V::load(&self.2.u[1]));
-                self.0.sample_latlong_lanes::<L::V>(self.1, u0, u1, self.3)
+                let Some(s) = self.0.sample_latlong_lanes::<L::V>(self.1, u0, u1, active) else {
+                    return false;
+                };
+                let zero = V3::<L::V>::splat(Vec3::ZERO);
+                keep(active, V3::<L::V>::load(&s.wi), &mut out.wi);
+                keep(active, V3::<L::V>::load(&s.radiance), &mut out.radiance);
+                keep(active, zero, &mut out.point);
+                keep(active, zero, &mut out.normal);
+                keep(active, zero, &mut out.point_error);
+                let pdf = L::V::select(active, L::V::load(&s.pdf), L::V::load(&out.pdf));
+                pdf.store(&mut out.pdf);
+                out.valid = (out.valid & !active) | s.valid;
+                out.distant |= active;
+                true
             }
         }
         let map = self.env.map(Repr::LatLong);
-        let Some(s) = simd::run(isa, LatLong(map, m.env.sampler, q, active)) else {
+        if !simd::run(isa, LatLong(map, m.env.sampler, q, active, out)) {
             out.valid &= !active; // a black map: nothing to sample
-            return;
-        };
-        let keep = |from: &Soa3, to: &mut Soa3| {
-            for lane in 0..WIDTH {
-                if active >> lane & 1 != 0 {
-                    to.set(lane, from.get(lane));
-                }
-            }
-        };
-        keep(&s.wi, &mut out.wi);
-        keep(&s.radiance, &mut out.radiance);
-        keep(&Soa3::default(), &mut out.point);
-        keep(&Soa3::default(), &mut out.normal);
-        keep(&Soa3::default(), &mut out.point_error);
-        for lane in 0..WIDTH {
-            if active >> lane & 1 != 0 {
-                out.pdf[lane] = s.pdf[lane];
-            }
         }
-        out.valid = (out.valid & !active) | s.valid;
-        out.distant |= active;
     }
 
     /// By direction: the environment has no points.
@@ -115,4 +116,11 @@ impl Light for EnvironmentLight {
             LightHit::Surface { .. } => 0.0,
         }
     }
+}
+
+/// `from` in the lanes of `m`, `to`'s own rows elsewhere (a function, not a closure: a closure
+/// is not always inlined into the ISA's entry).
+#[inline(always)]
+fn keep<V: Vector<{ crate::simd::WIDTH }>>(m: u32, from: V3<V>, to: &mut Soa3) {
+    V3::select(m, from, V3::load(to)).store(to);
 }
