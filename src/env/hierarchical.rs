@@ -91,12 +91,7 @@ impl HierarchicalWarp {
             running += levels.last().unwrap()[0];
             tile_cdf.push(running as f32);
             for level in levels.iter().rev().skip(1) {
-                let q = quads(level);
-                let mut lines = vec![Line::default(); q.len().div_ceil(4)];
-                for (m, quad) in q.into_iter().enumerate() {
-                    lines[m / 4].0[m % 4] = quad;
-                }
-                pyramid.extend(lines);
+                pyramid.extend(quads(level));
             }
         }
         (running > 0.0).then_some(HierarchicalWarp {
@@ -196,15 +191,16 @@ fn gather<V: Vector<N>, const N: usize>(lines: &[Line], at: &[usize; N], m: &[us
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in
-/// f32, the parent nodes in Morton order (bits of x at even positions, of y at odd ones).
-fn quads(level: &[f64]) -> Vec<[f32; 4]> {
+/// f32, the parent nodes in Morton order (bits of x at even positions, of y at odd ones),
+/// four quads to a line (the last line padded).
+fn quads(level: &[f64]) -> Vec<Line> {
     let s = level.len().isqrt();
     let h = s / 2;
-    let mut out = vec![[0.0f32; 4]; h * h];
+    let mut lines = vec![Line::default(); (h * h).div_ceil(4)];
     for py in 0..h {
         for px in 0..h {
-            let (x, y) = (2 * px, 2 * py);
-            out[morton(px, py)] = [
+            let (x, y, m) = (2 * px, 2 * py, morton(px, py));
+            lines[m / 4].0[m % 4] = [
                 level[y * s + x] as f32,
                 level[y * s + x + 1] as f32,
                 level[(y + 1) * s + x] as f32,
@@ -212,7 +208,7 @@ fn quads(level: &[f64]) -> Vec<[f32; 4]> {
             ];
         }
     }
-    out
+    lines
 }
 
 /// The Morton index of (x, y): bit b of x at bit 2b, bit b of y at bit 2b + 1.

@@ -4,11 +4,11 @@
 
 use super::bounds::{Bounds, DistantBounds};
 use super::{
-    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape,
+    LaneQuery, LaneSamples, Light, LightCtx, LightHit, LightMethods, LightSample, LightShape, keep,
     sample_lane_by_lane,
 };
 use crate::env::{EnvMethod, EnvSampler, Environment, ImportanceMap, Repr};
-use crate::simd::{self, Isa, Kernel, Lanes, Soa3, V3, Vector};
+use crate::simd::{self, Isa, Kernel, Lanes, V3, Vector};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -116,11 +116,4 @@ impl Light for EnvironmentLight {
             LightHit::Surface { .. } => 0.0,
         }
     }
-}
-
-/// `from` in the lanes of `m`, `to`'s own rows elsewhere (a function, not a closure: a closure
-/// is not always inlined into the ISA's entry).
-#[inline(always)]
-fn keep<V: Vector<{ crate::simd::WIDTH }>>(m: u32, from: V3<V>, to: &mut Soa3) {
-    V3::select(m, from, V3::load(to)).store(to);
 }
