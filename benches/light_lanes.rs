@@ -10,7 +10,7 @@ use dibench::lights::environment::EnvironmentLight;
 use dibench::lights::mesh::TriangleLight;
 use dibench::lights::quad::QuadLight;
 use dibench::lights::sphere::SphereLight;
-use dibench::lights::{LaneQuery, LaneSamples, Light, LightMethods, MeshMethod, QuadMethod};
+use dibench::lights::{LaneQueryRows, LaneSamples, Light, LightMethods, MeshMethod, QuadMethod};
 use dibench::sampling::stream::SampleStream;
 use dibench::simd::{Isa, WIDTH};
 use glam::Vec3;
@@ -19,11 +19,11 @@ use std::sync::Arc;
 use std::time::Duration;
 
 /// 64 packets of points on a floor 1.5 below the light, facing up, with random sample numbers.
-fn packets() -> Vec<LaneQuery> {
+fn packets() -> Vec<LaneQueryRows> {
     let mut rng = SampleStream::new(1, 2, 3, 4);
     (0..64)
         .map(|_| {
-            let mut q = LaneQuery::default();
+            let mut q = LaneQueryRows::default();
             for lane in 0..WIDTH {
                 let [a, b] = rng.next_2d();
                 q.p.set(lane, Vec3::new(4.0 * a - 2.0, 0.0, 4.0 * b - 2.0));
@@ -66,7 +66,7 @@ fn bench_light(c: &mut Criterion, name: &str, light: &dyn Light, m: &LightMethod
                 let mut acc = 0.0f32;
                 for q in &qs {
                     let mut out = LaneSamples::default();
-                    light.sample_lanes(isa, q, u32::MAX >> (32 - WIDTH), m, &mut out);
+                    light.sample_lanes(isa, &q.query(), u32::MAX >> (32 - WIDTH), m, &mut out);
                     acc += out.pdf.iter().sum::<f32>();
                 }
                 black_box(acc)

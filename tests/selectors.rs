@@ -14,7 +14,7 @@ use dibench::lights::selector::LightSelector;
 use dibench::lights::selector::bvh::LightBvh;
 use dibench::lights::selector::bvh_split::SPLIT;
 use dibench::lights::selector::exhaustive::Exhaustive;
-use dibench::lights::{LaneQuery, Light, LightCtx};
+use dibench::lights::{LaneQuery, LaneQueryRows, Light, LightCtx};
 use dibench::strategy::ShadingPoint;
 use dibench::tracer::LANES;
 use glam::Vec3;
@@ -118,7 +118,7 @@ fn a_constant_choice_is_what_sample_returns() {
 fn lanes_agree(sel: &dyn LightSelector, ctxs: &[LightCtx], seed: u64) -> Result<(), String> {
     let mut r = Rng::new(seed);
     for (k, group) in ctxs.chunks(LANES).enumerate() {
-        let mut q = LaneQuery::default();
+        let mut q = LaneQueryRows::default();
         let mut u = [0.0f64; LANES];
         for (lane, ctx) in group.iter().enumerate() {
             q.p.set(lane, ctx.p);
@@ -129,7 +129,7 @@ fn lanes_agree(sel: &dyn LightSelector, ctxs: &[LightCtx], seed: u64) -> Result<
         // Every third packet with some lanes off.
         let mask = if k % 3 == 2 { full & 0x5a5a } else { full };
         let (mut light, mut pmf) = ([usize::MAX; LANES], [-1.0f32; LANES]);
-        let picked = sel.sample_lanes(&q, &u, mask, &mut light, &mut pmf);
+        let picked = sel.sample_lanes(&q.query(), &u, mask, &mut light, &mut pmf);
         for lane in 0..LANES {
             let want = (mask >> lane & 1 != 0)
                 .then(|| sel.sample(&q.ctx(lane), u[lane]))

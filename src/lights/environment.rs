@@ -76,7 +76,7 @@ impl Light for EnvironmentLight {
         struct LatLong<'a>(
             &'a ImportanceMap,
             EnvSampler,
-            &'a LaneQuery,
+            &'a LaneQuery<'a>,
             u32,
             &'a mut LaneSamples,
         );

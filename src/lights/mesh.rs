@@ -162,7 +162,7 @@ fn sample_triangle_records(
 ) {
     struct Kernel<'a>(
         &'a LaneRecords,
-        &'a LaneQuery,
+        &'a LaneQuery<'a>,
         u32,
         MeshMethod,
         &'a mut LaneSamples,
@@ -461,7 +461,7 @@ fn chi2_case(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lights::MeshMethod;
+    use crate::lights::{LaneQueryRows, MeshMethod};
     use crate::sampling::stream::SampleStream;
 
     /// Where the kernel over records leaves [`TriangleLight::sample_solid_angle`] lane by
@@ -477,7 +477,7 @@ mod tests {
         };
         let mut tiny = 0;
         for round in 0..400 {
-            let mut q = LaneQuery::default();
+            let mut q = LaneQueryRows::default();
             let mut records: LaneRecords = [[0.0; WIDTH]; LANE_RECORD];
             let mut lights = Vec::new();
             for lane in 0..WIDTH {
@@ -513,7 +513,14 @@ mod tests {
             }
             for isa in Isa::available() {
                 let mut out = LaneSamples::default();
-                sample_triangle_records(isa, &scaled, &q, u32::MAX >> (32 - WIDTH), &m, &mut out);
+                sample_triangle_records(
+                    isa,
+                    &scaled,
+                    &q.query(),
+                    u32::MAX >> (32 - WIDTH),
+                    &m,
+                    &mut out,
+                );
                 for (lane, t) in lights.iter().enumerate() {
                     let want = t.sample_solid_angle(q.p.get(lane), [q.u[0][lane], q.u[1][lane]]);
                     let got = out.get(lane);

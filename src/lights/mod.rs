@@ -284,16 +284,57 @@ impl LightMethods {
 }
 
 /// The shading points of a packet's lanes that one light is sampled for at once (structure of
-/// arrays): what [`LightCtx`] and the three sample numbers are per lane.
+/// arrays): what [`LightCtx`] and the three sample numbers are per lane. It borrows the rows
+/// where they already are (the packet's points and normals, the pass's sample numbers): a copy
+/// per packet was a `memcpy` of 576 bytes, 2.7 % of a cornell `light` pass (docs/tracer.md,
+/// stop 47).
+#[derive(Clone, Copy, Debug)]
+pub struct LaneQuery<'a> {
+    pub p: &'a Soa3,
+    pub n: &'a Soa3,
+    /// `u[k][lane]`: the sample numbers [`Light::sample`] takes.
+    pub u: [&'a [f32; WIDTH]; 3],
+}
+
+impl LaneQuery<'_> {
+    pub fn ctx(&self, lane: usize) -> LightCtx {
+        LightCtx {
+            p: self.p.get(lane),
+            n: self.n.get(lane),
+        }
+    }
+}
+
+/// Owned rows of a [`LaneQuery`], for callers that fill a query lane by lane (tests, benches).
 #[derive(Clone, Copy, Debug, Default)]
-pub struct LaneQuery {
+pub struct LaneQueryRows {
     pub p: Soa3,
     pub n: Soa3,
-    /// `u[k][lane]`: the sample numbers [`Light::sample`] takes.
     pub u: [[f32; WIDTH]; 3],
 }
 
-impl LaneQuery {
+impl LaneQueryRows {
+    pub fn ctx(&self, lane: usize) -> LightCtx {
+        self.query().ctx(lane)
+    }
+
+    pub fn query(&self) -> LaneQuery<'_> {
+        LaneQuery {
+            p: &self.p,
+            n: &self.n,
+            u: [&self.u[0], &self.u[1], &self.u[2]],
+        }
+    }
+}
+
+/// The shading points of a packet's lanes, without sample numbers.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LanePoints {
+    pub p: Soa3,
+    pub n: Soa3,
+}
+
+impl LanePoints {
     pub fn ctx(&self, lane: usize) -> LightCtx {
         LightCtx {
             p: self.p.get(lane),
@@ -447,8 +488,8 @@ pub fn sample_lane_by_lane<T: Light + ?Sized>(
 /// arrays): what [`Light::pdf_lanes`] takes.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SurfaceLanes {
-    /// The shading points' positions and normals ([`LaneQuery::ctx`]; its `u` is not read).
-    pub from: LaneQuery,
+    /// The shading points' positions and normals.
+    pub from: LanePoints,
     /// The points on the light.
     pub q: Soa3,
     /// The light's part each point is on ([`LightHit::Surface`]'s `local`).
@@ -878,7 +919,7 @@ pub(crate) mod lane_tests {
 
     /// Lane `lane`'s sample numbers in round `round`: u at 0 and just below 1 among random ones.
     pub(crate) fn set_numbers(
-        q: &mut LaneQuery,
+        q: &mut LaneQueryRows,
         lane: usize,
         round: usize,
         rng: &mut SampleStream,

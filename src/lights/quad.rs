@@ -367,7 +367,13 @@ fn sample_quad_records(
 }
 
 /// Samples lanes `.2` of `.1` by method `.3` from quads `.0` (constants or records).
-struct QuadKernel<'a, S>(&'a S, &'a LaneQuery, u32, QuadMethod, &'a mut LaneSamples);
+struct QuadKernel<'a, S>(
+    &'a S,
+    &'a LaneQuery<'a>,
+    u32,
+    QuadMethod,
+    &'a mut LaneSamples,
+);
 
 impl<S: QuadLanes> Kernel for QuadKernel<'_, S> {
     type Out = ();
@@ -564,8 +570,8 @@ fn chi2_case(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lights::LightMethods;
     use crate::lights::lane_tests;
+    use crate::lights::{LaneQueryRows, LightMethods};
     use crate::sampling::stream::SampleStream;
 
     /// Spherical-rectangle samples of sixteen lanes at once are the scalar ones, bit for bit,
@@ -627,7 +633,7 @@ mod tests {
         let mut rng = SampleStream::new(5, 2, 6, 1);
         let mut kinds = [0usize; 3];
         for round in 0..400 {
-            let mut q = LaneQuery::default();
+            let mut q = LaneQueryRows::default();
             for lane in 0..WIDTH {
                 let p = viewpoint(&light, lane + round, &mut rng);
                 q.p.set(lane, p);
@@ -637,7 +643,7 @@ mod tests {
             }
             let active = lane_tests::active_lanes(round, &mut rng);
             let label = format!("round {round}");
-            lane_tests::assert_lanes_are_the_scalar_samples(&light, &q, active, &m, &label);
+            lane_tests::assert_lanes_are_the_scalar_samples(&light, &q.query(), active, &m, &label);
         }
         assert!(kinds.iter().all(|&k| k > 400), "{kinds:?}");
     }

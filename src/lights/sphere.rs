@@ -526,7 +526,7 @@ fn sample_cone_records(
 
 /// Cone samples of lanes `.2` of `.1` from spheres `.0` (constants or records); returns the
 /// lanes inside their sphere, which the caller samples one at a time.
-struct ConeKernel<'a, S>(&'a S, &'a LaneQuery, u32, &'a mut LaneSamples);
+struct ConeKernel<'a, S>(&'a S, &'a LaneQuery<'a>, u32, &'a mut LaneSamples);
 
 impl<S: SphereLanes> Kernel for ConeKernel<'_, S> {
     type Out = u32;
@@ -676,8 +676,8 @@ fn chi2_case(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lights::LightMethods;
     use crate::lights::lane_tests;
+    use crate::lights::{LaneQueryRows, LightMethods};
     use crate::sampling::stream::SampleStream;
 
     /// Cone samples of sixteen lanes at once are the scalar ones, bit for bit, on every ISA:
@@ -693,7 +693,7 @@ mod tests {
         let m = LightMethods::BASIC;
         let mut rng = SampleStream::new(3, 1, 4, 1);
         for round in 0..400 {
-            let mut q = LaneQuery::default();
+            let mut q = LaneQueryRows::default();
             for lane in 0..WIDTH {
                 let [a, b] = rng.next_2d();
                 let dir = crate::sampling::warp::sample_uniform_sphere([a, b]);
@@ -710,7 +710,7 @@ mod tests {
             }
             let active = lane_tests::active_lanes(round, &mut rng);
             let label = format!("round {round}");
-            lane_tests::assert_lanes_are_the_scalar_samples(&light, &q, active, &m, &label);
+            lane_tests::assert_lanes_are_the_scalar_samples(&light, &q.query(), active, &m, &label);
         }
     }
 }

@@ -345,8 +345,11 @@ impl<'s> BoundLights<'s> {
         out: &mut ProbePacket,
         weight: &W,
     ) {
-        let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
-        let r = self.shadow_rays(packet, u, &mut ls, &mut light);
+        let mut light = [usize::MAX; LANES];
+        let ls = &mut out.light_samples;
+        (ls.valid, ls.distant) = (0, 0);
+        let r = self.shadow_rays(packet, u, ls, &mut light);
+        let ls = &out.light_samples;
         let valid = r.valid & packet.mask;
         let (o, origin) = (&mut out.shadow, &packet.geo.origin);
         (o.ox, o.oy, o.oz) = (origin.x, origin.y, origin.z);
@@ -418,9 +421,9 @@ impl<'s> BoundLights<'s> {
         let [u_select, u0, u1, u2] = u.take::<4>();
         // The points and their sample numbers, as rows (no lane is moved on its own).
         let q = LaneQuery {
-            p: packet.p,
-            n: packet.geo.n,
-            u: [*u0, *u1, *u2],
+            p: &packet.p,
+            n: &packet.geo.n,
+            u: [u0, u1, u2],
         };
         let mut x = ShadowLanes {
             pmf: [0.0; WIDTH],
@@ -490,7 +493,7 @@ impl<'s> BoundLights<'s> {
                 .get(i)
                 .sample_lanes(self.isa, &q, mask, &self.methods, ls);
         }
-        struct Kernel<'a>(&'a LaneQuery, &'a LaneSamples, &'a ShadowLanes<'a>);
+        struct Kernel<'a>(&'a LaneQuery<'a>, &'a LaneSamples, &'a ShadowLanes<'a>);
         impl simd::Kernel for Kernel<'_> {
             type Out = ShadowRays;
             #[inline(always)]
