@@ -21,13 +21,10 @@ pub struct SampleStream {
 const MULTIPLIER: u64 = 6_364_136_223_846_793_005;
 
 /// XSH-RR of every lane (O'Neill 2014, §6.3.1): xorshift the high bits down, then rotate the
-/// 32-bit word by the top five bits; each output in the low half of its lane. The rotation is
-/// the word doubled into 64 bits and shifted right.
+/// 32-bit word by the top five bits; each output in the low half of its lane.
 #[inline(always)]
 fn xsh_rr<U: VectorU64<N>, const N: usize>(state: U) -> U {
-    let low = U::splat(0xffff_ffff);
-    let xsh = state.shr(18).xor(state).shr(27).and(low);
-    xsh.or(xsh.shl(32)).shr_lanes(state.shr(59)).and(low)
+    state.shr(18).xor(state).shr(27).rotr32(state.shr(59))
 }
 
 /// One LCG step of every lane.

@@ -342,6 +342,18 @@ impl VectorU64<WIDTH> for ZU {
     opu!(and, _mm512_and_si512);
     opu!(shr_lanes, _mm512_srlv_epi64);
     #[inline(always)]
+    fn rotr32(self, k: Self) -> Self {
+        // Each 64-bit lane is two 32-bit words: the low one rotated by k (< 32), the high one
+        // by k's zero high word, then cleared.
+        unsafe {
+            let low = _mm512_set1_epi64(0xffff_ffff);
+            ZU(
+                _mm512_and_si512(_mm512_rorv_epi32(self.0, k.0), low),
+                _mm512_and_si512(_mm512_rorv_epi32(self.1, k.1), low),
+            )
+        }
+    }
+    #[inline(always)]
     fn shr(self, k: u32) -> Self {
         unsafe {
             let k = _mm_cvtsi32_si128(k as i32);

@@ -144,6 +144,16 @@ pub trait VectorU64<const N: usize>: Copy {
     fn shr_lanes(self, k: Self) -> Self;
     /// Each lane, which must be below 2³¹, rounded to the nearest f32 (`as f32`).
     fn to_f32(self, a: &mut [f32; N]);
+    /// Each lane's low 32 bits rotated right by the same lane of `k` (each < 32), as a lane
+    /// below 2³² (`(x as u32).rotate_right(k as u32) as u64`; the high halves of `self` are
+    /// ignored). By default the word doubled into 64 bits and shifted; AVX-512 rotates 32-bit
+    /// words in one instruction (`vprorvd`).
+    #[inline(always)]
+    fn rotr32(self, k: Self) -> Self {
+        let low = Self::splat(0xffff_ffff);
+        let x = self.and(low);
+        x.or(x.shl(32)).shr_lanes(k).and(low)
+    }
 }
 
 /// One ISA's vector types. A zero-sized type, so a kernel names its ISA once.
