@@ -487,7 +487,12 @@ impl<'s> BoundLights<'s> {
         let mut rest = chosen & !with_kernel;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
-            let mask = lanes_holding(light, i) & chosen;
+            // One light for every lane holds them all (no lane-by-lane comparison).
+            let mask = if constant.is_some() {
+                chosen
+            } else {
+                lanes_holding(light, i) & chosen
+            };
             rest &= !mask;
             self.lights
                 .get(i)
