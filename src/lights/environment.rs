@@ -86,7 +86,7 @@ impl Light for EnvironmentLight {
             #[inline(always)]
             fn run<L: Lanes>(self) -> bool {
                 let (active, out) = (self.3, self.4);
-                let (u0, u1) = (L::V::load(&self.2.u[0]), L::V::load(&self.2.u[1]));
+                let (u0, u1) = (L::V::load(self.2.u[0]), L::V::load(self.2.u[1]));
                 let Some(s) = self.0.sample_latlong_lanes::<L::V>(self.1, u0, u1, active) else {
                     return false;
                 };

@@ -192,7 +192,7 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     a: u32,
     out: &mut LaneSamples,
 ) {
-    let p = V3::<V>::load(&q.p);
+    let p = V3::<V>::load(q.p);
     let v0 = record_rows::<V>(r, 0);
     let normal = record_rows::<V>(r, 9);
     let faces = a & V::splat(0.0).lt((p - v0).dot(normal));
@@ -203,7 +203,7 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     let big = !triangle_solid_angle_lanes(ta, tb, tc).lt(D::splat(MIN_SOLID_ANGLE));
     let (st, ok) = SphericalTriangle::<D>::lanes(ta, tb, tc);
     let solid = faces & big & ok;
-    let w = st.sample_lanes(D::from_f32(&q.u[0]), D::from_f32(&q.u[1]));
+    let w = st.sample_lanes(D::from_f32(q.u[0]), D::from_f32(q.u[1]));
     // Where the direction meets the triangle's plane; none where it grazes it.
     let n = record_rows_d::<D>(r, 9);
     let cos = dot3(w, n);
@@ -248,11 +248,11 @@ fn unit_from<V: Vector<WIDTH>, D: Vector64<WIDTH>>(v: V3<V>, p: V3<V>) -> [D; 3]
 #[inline(always)]
 fn area_lanes<V: Vector<WIDTH>>(r: &LaneRecords, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
     let v3 = |k: usize| record_rows::<V>(r, k);
-    let (b1, b2) = uniform_triangle(V::load(&q.u[0]), V::load(&q.u[1]));
+    let (b1, b2) = uniform_triangle(V::load(q.u[0]), V::load(q.u[1]));
     let (point, error) = Triangle::point_lanes([v3(0), v3(3), v3(6)], b1, b2);
     let normal = v3(9);
     // direction_to
-    let d = point - V3::load(&q.p);
+    let d = point - V3::load(q.p);
     let d2 = d.dot(d);
     let wi = d / d2.sqrt();
     let cos_l = normal.dot(wi).neg();

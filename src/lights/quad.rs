@@ -264,12 +264,12 @@ impl QuadLanes for LaneRecords {
 #[inline(always)]
 fn area_lanes<V: Vector<WIDTH>>(s: &impl QuadLanes, q: &LaneQuery, a: u32, out: &mut LaneSamples) {
     let zero = V::splat(0.0);
-    let (u0, u1) = (V::load(&q.u[0]), V::load(&q.u[1]));
+    let (u0, u1) = (V::load(q.u[0]), V::load(q.u[1]));
     let eu = s.edge_u::<V>().scale(u0);
     let ev = s.edge_v::<V>().scale(u1);
     let point = s.corner::<V>() + eu + ev;
     // direction_to
-    let d = point - V3::load(&q.p);
+    let d = point - V3::load(q.p);
     let d2 = d.dot(d);
     let wi = d / d2.sqrt();
     let cos_l = s.normal::<V>().dot(wi).neg();
@@ -296,9 +296,9 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     a: u32,
     out: &mut LaneSamples,
 ) {
-    let p = V3::<V>::load(&q.p);
+    let p = V3::<V>::load(q.p);
     let (rect, faces, solid) = rect_lanes::<V, D>(s, p, a);
-    let d = rect.sample_lanes(D::from_f32(&q.u[0]), D::from_f32(&q.u[1]));
+    let d = rect.sample_lanes(D::from_f32(q.u[0]), D::from_f32(q.u[1]));
     let dist = dot3(d, d).sqrt();
     let wi = V3 {
         x: f32s::<V, D>(d[0].div(dist)),

@@ -456,7 +456,7 @@ fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     };
     let (fs, ft) = Frame::from_normal_lanes(axis);
     let omc32 = f32s::<V, D>(omc_max);
-    let (lx32, ly32, lz32) = uniform_cone(V::load(&q.u[0]), V::load(&q.u[1]), omc32);
+    let (lx32, ly32, lz32) = uniform_cone(V::load(q.u[0]), V::load(q.u[1]), omc32);
     let (lx, ly, cos_t) = (d64::<V, D>(lx32), d64::<V, D>(ly32), d64::<V, D>(lz32));
     let sin2_t = lx.mul(lx).add(ly.mul(ly));
     let t = d2.sub(r2).div(

@@ -129,7 +129,7 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
     let zero = V::splat(0.0);
     let wi = V3::<V>::load(&ls.wi);
     let pdf = V::load(&ls.pdf).mul(V::load(&x.pmf));
-    let cos = V3::load(&q.n).dot(wi);
+    let cos = V3::load(q.n).dot(wi);
     let mut valid = ls.valid & !cos.le(zero);
     let origin = V3::load(&x.geo.origin);
     let point = V3::load(&ls.point);
@@ -385,7 +385,7 @@ impl<'s> BoundLights<'s> {
         shadow_values(
             packet,
             &r,
-            &ls,
+            ls,
             valid & !diffuse,
             |lane, bsdf, local, value| {
                 let w = weight.lane(bsdf, r.pdf[lane], local, light[lane]);
