@@ -90,6 +90,10 @@ impl LightSampling {
 /// methods resolved once for this scene and integrand.
 pub struct BoundLights<'s> {
     pub lights: &'s LightSet,
+    /// Each light's kernel over lanes and its record for these methods
+    /// ([`Light::lane_record`]), asked once at bind: a packet reads a lane's record from here
+    /// instead of a dynamic call per lane (5 % of a mesh_light pass; docs/tracer.md, stop 47).
+    records: Vec<Option<(&'static LaneKernel, [f32; LANE_RECORD])>>,
     pub selector: &'s dyn LightSelector,
     pub methods: LightMethods,
     /// The lane layer's instruction set for [`Self::probe_packet`] (every ISA gives the same
@@ -253,14 +257,19 @@ impl<'s> BoundLights<'s> {
         methods: LightMethods,
     ) -> Result<Self, String> {
         let selector = scene.lights.selector(selector)?;
+        let methods = scene
+            .lights
+            .usable_methods(methods)
+            .with_env_repr(scene.env);
+        let records = (0..scene.lights.len())
+            .map(|i| scene.lights.get(i).lane_record(&methods))
+            .collect();
         Ok(BoundLights {
             lights: scene.lights,
+            records,
             isa: Isa::detect().unwrap_or(Isa::Portable),
             selector,
-            methods: scene
-                .lights
-                .usable_methods(methods)
-                .with_env_repr(scene.env),
+            methods,
         })
     }
 
@@ -311,7 +320,8 @@ impl<'s> BoundLights<'s> {
         mut emit: impl FnMut(usize, LightProbe),
     ) {
         let (mut ls, mut light) = (LaneSamples::default(), [usize::MAX; LANES]);
-        let r = self.shadow_rays(packet, u, &mut ls, &mut light);
+        let mut records = [[0.0; LANES]; LANE_RECORD];
+        let r = self.shadow_rays(packet, u, &mut ls, &mut records, &mut light);
         shadow_values(
             packet,
             &r,
@@ -348,7 +358,7 @@ impl<'s> BoundLights<'s> {
         let mut light = [usize::MAX; LANES];
         let ls = &mut out.light_samples;
         (ls.valid, ls.distant) = (0, 0);
-        let r = self.shadow_rays(packet, u, ls, &mut light);
+        let r = self.shadow_rays(packet, u, ls, &mut out.light_records, &mut light);
         let ls = &out.light_samples;
         let valid = r.valid & packet.mask;
         let (o, origin) = (&mut out.shadow, &packet.geo.origin);
@@ -416,6 +426,7 @@ impl<'s> BoundLights<'s> {
         packet: &ShadingPacket,
         u: &mut PacketDims,
         ls: &mut LaneSamples,
+        records: &mut LaneRecords,
         light: &mut [usize; LANES],
     ) -> ShadowRays {
         let [u_select, u0, u1, u2] = u.take::<4>();
@@ -450,21 +461,16 @@ impl<'s> BoundLights<'s> {
         // every lane samples them itself below ([`Light::sample_lanes`], its parameters
         // constants).
         let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
-        // On the stack, zeroed only when a lane has a kernel (a heap record was a malloc and a
-        // free per packet: 2.4 % of a mesh_light `light` pass).
-        let mut records: Option<LaneRecords> = None;
+        // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
+        // mesh_light `light` pass); lanes without a kernel keep whatever they held.
         let mut with_kernel = 0u32;
         let mut rest = if constant.is_some() { 0 } else { chosen };
         while rest != 0 {
             let lane = rest.trailing_zeros() as usize;
             rest &= rest - 1;
-            if let Some((k, r)) = self.lights.get(light[lane]).lane_record(&self.methods) {
-                if records.is_none() {
-                    records = Some([[0.0; LANES]; LANE_RECORD]);
-                }
-                let records = records.as_mut().expect("records made above");
+            if let Some((k, r)) = &self.records[light[lane]] {
                 for (field, v) in records.iter_mut().zip(r) {
-                    field[lane] = v;
+                    field[lane] = *v;
                 }
                 kernels[lane] = Some(k);
                 with_kernel |= 1 << lane;
@@ -480,7 +486,6 @@ impl<'s> BoundLights<'s> {
                 }
             }
             rest &= !mask;
-            let records = records.as_ref().expect("records for lanes with a kernel");
             (k.sample)(self.isa, records, &q, mask, &self.methods, ls);
         }
         // Each other chosen light samples its lanes at once.

@@ -17,7 +17,7 @@ pub mod mis;
 use crate::bsdf::{Bsdf, LocalBsdf};
 use crate::env::{EnvMethod, EnvSampler, Repr};
 use crate::geometry::Ray;
-use crate::lights::{LaneSamples, LightCtx};
+use crate::lights::{LaneRecords, LaneSamples, LightCtx};
 use crate::math::{Frame, offset_ray_origin, offset_ray_origin_lanes};
 use crate::prepare::{PreparedScene, SceneView, SurfaceHit};
 use crate::sampling::{Dims, Layout, PacketDims};
@@ -275,6 +275,10 @@ pub struct ProbePacket {
     /// packet's: every sampler writes each field of the lanes it draws for, and its user
     /// resets `valid` first.
     pub light_samples: LaneSamples,
+    /// Scratch for the lights' lane records ([`crate::lights::LaneKernel`]), likewise kept
+    /// (zeroing it was a 1 KB `memset` per packet, 0.75 % of a mesh_light MIS pass): only the
+    /// lanes a kernel samples are read for their result, and those are written first.
+    pub light_records: LaneRecords,
 }
 
 impl ProbePacket {
