@@ -27,7 +27,7 @@ crate::plugin::registry! {
 use crate::env::{EnvMethod, Environment, Repr};
 use crate::geometry::Ray;
 use crate::math::offset_ray_origin;
-use crate::simd::{Isa, Soa3, V3, Vector, Vector64, WIDTH};
+use crate::simd::{self, Isa, Soa3, V3, Vector, Vector64, WIDTH};
 use bounds::Bounds;
 use glam::Vec3;
 use selector::{LightSelector, SELECTORS, SelectorType};
@@ -896,6 +896,35 @@ pub fn selection_number(hi: f32, lo: f32) -> f64 {
     (hi as f64 * GRID) as i64 as f64 / GRID + lo as f64 / GRID
 }
 
+/// [`selection_number`] of 16 lanes at once, bit for bit, on the CPU's best ISA (lane by lane
+/// it was 2 % of a mesh_light pass: scalar conversions outside any ISA kernel; docs/tracer.md,
+/// stop 47).
+pub fn selection_numbers(isa: Isa, hi: &[f32; WIDTH], lo: &[f32; WIDTH], out: &mut [f64; WIDTH]) {
+    struct Numbers<'a>(&'a [f32; WIDTH], &'a [f32; WIDTH], &'a mut [f64; WIDTH]);
+    impl simd::Kernel for Numbers<'_> {
+        type Out = ();
+        #[inline(always)]
+        fn run<L: simd::Lanes>(self) {
+            selection_number_lanes::<L::D>(self.0, self.1).to_f64(self.2);
+        }
+    }
+    simd::run(isa, Numbers(hi, lo, out));
+}
+
+/// [`selection_number`] over f64 lanes. The floor of x = hi·2²⁴ (0 ≤ x < 2²⁴) without a floor
+/// instruction: x + 2⁵² − 2⁵² is x rounded to the nearest integer (exact in f64 below 2⁵²),
+/// one less where that rounded up. The divisions by 2²⁴ are exact products.
+#[inline(always)]
+fn selection_number_lanes<D: Vector64<WIDTH>>(hi: &[f32; WIDTH], lo: &[f32; WIDTH]) -> D {
+    const GRID: f64 = 16_777_216.0;
+    let x = D::from_f32(hi).mul(D::splat(GRID));
+    let big = D::splat(4_503_599_627_370_496.0);
+    let near = x.add(big).sub(big);
+    let floor = near.sub(D::select(x.lt(near), D::splat(1.0), D::splat(0.0)));
+    let unit = D::splat(1.0 / GRID);
+    floor.mul(unit).add(D::from_f32(lo).mul(unit))
+}
+
 /// What the lights' lane tests share: a light's samples over lanes against its scalar ones.
 #[cfg(test)]
 pub(crate) mod lane_tests {
@@ -1009,5 +1038,67 @@ pub(crate) mod lane_tests {
                 );
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod selection_number_tests {
+    use super::*;
+    use crate::sampling::stream::{ONE_MINUS_EPSILON, SampleStream};
+
+    /// Sample numbers that test the floor: on the 2⁻²⁴ grid, just below grid points, finer
+    /// than the grid near 0 (subnormals included), 0 and the largest below 1, and random
+    /// f32 bits in [0, 1).
+    fn numbers() -> Vec<f32> {
+        let mut v = vec![0.0, ONE_MINUS_EPSILON, f32::MIN_POSITIVE, 1e-30, 1e-40, 0.5];
+        let mut rng = SampleStream::new(5, 6, 7, 8);
+        for _ in 0..4000 {
+            let grid = (rng.next_1d() * 16_777_216.0).floor() / 16_777_216.0;
+            let below = f32::from_bits(grid.to_bits().saturating_sub(1));
+            let any = f32::from_bits((rng.next_1d() * 1_065_353_216.0) as u32);
+            v.extend([grid, below, any, rng.next_1d() * 1e-6]);
+        }
+        v.retain(|x| (0.0..1.0).contains(x));
+        v
+    }
+
+    /// `numbers` against `selection_number` lane by lane, bit for bit, on every ISA.
+    fn lanes_match(
+        f: impl Fn(Isa, &[f32; WIDTH], &[f32; WIDTH], &mut [f64; WIDTH]),
+    ) -> Result<(), String> {
+        let v = numbers();
+        for (k, hi) in v.chunks_exact(WIDTH).enumerate() {
+            let hi: [f32; WIDTH] = hi.try_into().unwrap();
+            let lo: [f32; WIDTH] = std::array::from_fn(|l| v[(k * 7 + l * 3) % v.len()]);
+            for isa in Isa::available() {
+                let mut got = [0.0; WIDTH];
+                f(isa, &hi, &lo, &mut got);
+                for l in 0..WIDTH {
+                    let want = selection_number(hi[l], lo[l]);
+                    if got[l].to_bits() != want.to_bits() {
+                        return Err(format!(
+                            "{isa:?}: hi {:e} lo {:e}: {} against {want}",
+                            hi[l], lo[l], got[l]
+                        ));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The lanes' floor is the scalar truncation. Control: rounding to the nearest grid point
+    /// instead of down is caught.
+    #[test]
+    fn lanes_are_the_scalar_numbers() {
+        lanes_match(selection_numbers).unwrap();
+        let rounded = |_: Isa, hi: &[f32; WIDTH], lo: &[f32; WIDTH], out: &mut [f64; WIDTH]| {
+            const GRID: f64 = 16_777_216.0;
+            for l in 0..WIDTH {
+                out[l] = (hi[l] as f64 * GRID).round() / GRID + lo[l] as f64 / GRID;
+            }
+        };
+        let e = lanes_match(rounded).unwrap_err();
+        eprintln!("caught: {e}");
     }
 }

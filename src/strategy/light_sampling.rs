@@ -13,7 +13,7 @@ use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
 use crate::lights::{
-    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, SHADOW_EPSILON, selection_number,
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, SHADOW_EPSILON, selection_numbers,
 };
 use crate::lights::{
     LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride, SurfaceLanes,
@@ -449,9 +449,7 @@ impl<'s> BoundLights<'s> {
             x.pmf = [pmf; WIDTH];
         } else {
             let mut numbers = [0.0f64; LANES];
-            for (n, (&hi, &lo)) in numbers.iter_mut().zip(u_select.iter().zip(u2.iter())) {
-                *n = selection_number(hi, lo);
-            }
+            selection_numbers(self.isa, u_select, u2, &mut numbers);
             chosen = self
                 .selector
                 .sample_lanes(&q, &numbers, packet.mask, light, &mut x.pmf);
