@@ -896,7 +896,7 @@ pub fn selection_number(hi: f32, lo: f32) -> f64 {
     (hi as f64 * GRID) as i64 as f64 / GRID + lo as f64 / GRID
 }
 
-/// [`selection_number`] of 16 lanes at once, bit for bit, on the CPU's best ISA (lane by lane
+/// [`selection_number`] of 16 lanes at once, bit for bit, on `isa` (lane by lane
 /// it was 2 % of a mesh_light pass: scalar conversions outside any ISA kernel; docs/tracer.md,
 /// stop 47).
 pub fn selection_numbers(isa: Isa, hi: &[f32; WIDTH], lo: &[f32; WIDTH], out: &mut [f64; WIDTH]) {

@@ -356,9 +356,8 @@ impl<'s> BoundLights<'s> {
         weight: &W,
     ) {
         let mut light = [usize::MAX; LANES];
-        let ls = &mut out.light_samples;
-        (ls.valid, ls.distant) = (0, 0);
-        let r = self.shadow_rays(packet, u, ls, &mut out.light_records, &mut light);
+        let (ls, records) = (&mut out.light_samples, &mut out.light_records);
+        let r = self.shadow_rays(packet, u, ls, records, &mut light);
         let ls = &out.light_samples;
         let valid = r.valid & packet.mask;
         let (o, origin) = (&mut out.shadow, &packet.geo.origin);
@@ -430,6 +429,9 @@ impl<'s> BoundLights<'s> {
         light: &mut [usize; LANES],
     ) -> ShadowRays {
         let [u_select, u0, u1, u2] = u.take::<4>();
+        // `ls` may hold an earlier packet's samples (scratch): no lane is valid until a light
+        // samples it.
+        (ls.valid, ls.distant) = (0, 0);
         // The points and their sample numbers, as rows (no lane is moved on its own).
         let q = LaneQuery {
             p: &packet.p,

@@ -272,8 +272,8 @@ pub struct ProbePacket {
     /// Scratch for the light samples an estimator draws on the way to its rows, kept with the
     /// packet so that it is not zeroed per packet (a `memset` of 1 KB, 2.1 % of a cornell
     /// `light` pass; docs/tracer.md, stop 47). Only the lanes of its `valid` mask are this
-    /// packet's: every sampler writes each field of the lanes it draws for, and its user
-    /// resets `valid` first.
+    /// packet's: every sampler writes each field of the lanes it draws for, and the light
+    /// estimators' `shadow_rays` clears `valid` first.
     pub light_samples: LaneSamples,
     /// Scratch for the lights' lane records ([`crate::lights::LaneKernel`]), likewise kept
     /// (zeroing it was a 1 KB `memset` per packet, 0.75 % of a mesh_light MIS pass): only the
