@@ -27,10 +27,12 @@ pub struct SphereLight {
 }
 
 impl SphereLight {
-    /// Axis (centre − p), squared distance and 1 − cos θmax of the cone the sphere subtends
-    /// from an outside point, in f64: from 1e-6 above a unit sphere, d² − r² = 2e-6 would keep
-    /// only 4 bits in f32. 1 − cos θmax = sin²θmax/(1 + cos θmax) with cos²θmax = (d² − r²)/d².
-    fn cone_extent(&self, p: Vec3) -> Option<(DVec3, f64, f64)> {
+    /// Axis (centre − p), squared distance, distance and 1 − cos θmax of the cone the sphere
+    /// subtends from an outside point, in f64: from 1e-6 above a unit sphere, d² − r² = 2e-6
+    /// would keep only 4 bits in f32. 1 − cos θmax = sin²θmax/(1 + cos θmax) with sin θmax = r/d
+    /// and cos θmax = sqrt(d² − r²)/d, i.e. r²/(d² + d·sqrt(d² − r²)): one division, no
+    /// cancellation.
+    fn cone_extent(&self, p: Vec3) -> Option<(DVec3, f64, f64, f64)> {
         let to_c = self.center.as_dvec3() - p.as_dvec3();
         let d2 = to_c.length_squared();
         let r = self.radius as f64;
@@ -38,19 +40,18 @@ impl SphereLight {
         if d2 <= r2 {
             return None;
         }
-        let omc_max = (r2 / d2) / (1.0 + ((d2 - r2) / d2).sqrt());
-        Some((to_c, d2, omc_max))
+        let dc = d2.sqrt();
+        let omc_max = r2 / (d2 + dc * (d2 - r2).sqrt());
+        Some((to_c, d2, dc, omc_max))
     }
 
     pub fn sample_cone(&self, p: Vec3, u: [f32; 2]) -> Option<LightSample> {
-        let Some((to_c, d2, omc_max)) = self.cone_extent(p) else {
+        let Some((to_c, d2, dc, omc_max)) = self.cone_extent(p) else {
             return self.sample_directions_inside(p, u);
         };
-        let dc = d2.sqrt();
         let r = self.radius as f64;
-        // Products with one reciprocal where a quotient per component was (here and for φ
-        // below): the f64 results differ by an ulp at most, which the rounding to f32 almost
-        // always hides; three f64 divisions fewer per sample over lanes.
+        // A product with one reciprocal where a quotient per component was: the f64 results
+        // differ by an ulp at most, which the rounding to f32 almost always hides.
         let inv_dc = 1.0 / dc;
         let frame = Frame::from_normal((to_c * inv_dc).as_vec3());
         let local = sample_uniform_cone(u, omc_max as f32);
@@ -58,22 +59,18 @@ impl SphereLight {
         // cancellation. Its distance is the smaller root of the ray–sphere quadratic in the
         // form t = (d² − r²)/(d cos θ + sqrt(r² − d² sin²θ)); the angle α at the centre between
         // the axis towards p and the point follows from the law of sines, sin α = t sin θ / r.
+        // With (x, y) = sin θ (cos φ, sin φ), the normal's part across the axis is
+        // sin α (cos φ, sin φ) = (t/r)(x, y): no sin θ, and no division by it.
         // (Akalin's cos α = sin²θ/sin θmax + cos θ·sqrt(1 − sin²θ/sin²θmax), used by pbrt-v4,
         // rounds cos α to 1 in f32 when p is 1e-6 from the surface: every direction with θ < 60°
         // then lands on the foot point. A ray cast in f32 would lose tiny spheres instead.)
         let (lx, ly, cos_t) = (local.x as f64, local.y as f64, local.z as f64);
         let sin2_t = lx * lx + ly * ly;
-        let t = (d2 - r * r) / (dc * cos_t + (r * r - d2 * sin2_t).max(0.0).sqrt());
-        let sin_t = sin2_t.sqrt();
-        let sin_a = (t * sin_t / r).min(1.0);
-        let cos_a = (1.0 - sin_a * sin_a).sqrt(); // α ≤ acos(r/d) < 90°
-        let (cos_phi, sin_phi) = if sin_t > 0.0 {
-            let inv = 1.0 / sin_t;
-            (lx * inv, ly * inv)
-        } else {
-            (1.0, 0.0)
-        };
-        let normal = frame.to_world(DVec3::new(sin_a * cos_phi, sin_a * sin_phi, -cos_a).as_vec3());
+        let k = (d2 - r * r) / (r * (dc * cos_t + (r * r - d2 * sin2_t).max(0.0).sqrt()));
+        // α ≤ 90° − θmax < 90°; a direction that the f32 warp rounds out of the cone can take
+        // sin²α a rounding above 1, where cos α is 0.
+        let cos_a = (1.0 - k * k * sin2_t).max(0.0).sqrt();
+        let normal = frame.to_world(DVec3::new(k * lx, k * ly, -cos_a).as_vec3());
         let point = self.center + normal * self.radius;
         Some(LightSample {
             // The sampled direction itself, which the cone pdf describes; `point` (rounded to
@@ -103,7 +100,7 @@ impl SphereLight {
         let axis = to_c / d2.sqrt();
         let inside = wi.dot(axis) > 0.0 && wi.cross(axis).length_squared() <= sin2_max;
         match self.cone_extent(p) {
-            Some((_, _, omc_max)) if inside => uniform_cone_pdf(omc_max as f32),
+            Some((_, _, _, omc_max)) if inside => uniform_cone_pdf(omc_max as f32),
             _ => 0.0,
         }
     }
@@ -445,9 +442,9 @@ fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     // square root of a negative number; their results are not used.
     let one = D::splat(1.0);
     let d2 = D::select(inside, D::splat(2.0).mul(r2).add(one), d2);
-    let omc_max = r2.div(d2).div(one.add(d2.sub(r2).div(d2).sqrt()));
-    // sample_cone
     let dc = d2.sqrt();
+    let omc_max = r2.div(d2.add(dc.mul(d2.sub(r2).sqrt())));
+    // sample_cone
     let inv_dc = one.div(dc);
     let axis = V3 {
         x: f32s::<V, D>(to_c[0].mul(inv_dc)),
@@ -459,20 +456,16 @@ fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     let (lx32, ly32, lz32) = uniform_cone(V::load(q.u[0]), V::load(q.u[1]), omc32);
     let (lx, ly, cos_t) = (d64::<V, D>(lx32), d64::<V, D>(ly32), d64::<V, D>(lz32));
     let sin2_t = lx.mul(lx).add(ly.mul(ly));
-    let t = d2.sub(r2).div(
-        dc.mul(cos_t)
-            .add(r2.sub(d2.mul(sin2_t)).max(D::splat(0.0)).sqrt()),
+    let k = d2.sub(r2).div(
+        r.mul(
+            dc.mul(cos_t)
+                .add(r2.sub(d2.mul(sin2_t)).max(D::splat(0.0)).sqrt()),
+        ),
     );
-    let sin_t = sin2_t.sqrt();
-    let sin_a = t.mul(sin_t).div(r).min(one);
-    let cos_a = one.sub(sin_a.mul(sin_a)).sqrt();
-    let turned = D::splat(0.0).lt(sin_t);
-    let inv = one.div(D::select(turned, sin_t, one));
-    let cos_phi = D::select(turned, lx.mul(inv), one);
-    let sin_phi = D::select(turned, ly.mul(inv), D::splat(0.0));
+    let cos_a = one.sub(k.mul(k).mul(sin2_t)).max(D::splat(0.0)).sqrt();
     let (nx, ny, nz) = (
-        f32s::<V, D>(sin_a.mul(cos_phi)),
-        f32s::<V, D>(sin_a.mul(sin_phi)),
+        f32s::<V, D>(k.mul(lx)),
+        f32s::<V, D>(k.mul(ly)),
         f32s::<V, D>(cos_a).neg(),
     );
     // Frame::to_world in glam's order.
