@@ -13,7 +13,8 @@ use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
 use crate::lights::{
-    LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, SHADOW_EPSILON, selection_numbers,
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecord, LaneRecords, LaneSamples, SHADOW_EPSILON,
+    gather_records, selection_numbers,
 };
 use crate::lights::{
     LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride, SurfaceLanes,
@@ -93,7 +94,9 @@ pub struct BoundLights<'s> {
     /// Each light's kernel over lanes and its record for these methods
     /// ([`Light::lane_record`]), asked once at bind: a packet reads a lane's record from here
     /// instead of a dynamic call per lane (5 % of a mesh_light pass; docs/tracer.md, stop 47).
-    records: Vec<Option<(&'static LaneKernel, [f32; LANE_RECORD])>>,
+    kernels: Vec<Option<&'static LaneKernel>>,
+    /// The records, one cache line each ([`LaneRecord::ZERO`] for lights without a kernel).
+    records: Vec<LaneRecord>,
     pub selector: &'s dyn LightSelector,
     pub methods: LightMethods,
     /// The lane layer's instruction set for [`Self::probe_packet`] (every ISA gives the same
@@ -261,11 +264,15 @@ impl<'s> BoundLights<'s> {
             .lights
             .usable_methods(methods)
             .with_env_repr(scene.env);
-        let records = (0..scene.lights.len())
-            .map(|i| scene.lights.get(i).lane_record(&methods))
-            .collect();
+        let (kernels, records) = (0..scene.lights.len())
+            .map(|i| match scene.lights.get(i).lane_record(&methods) {
+                Some((k, r)) => (Some(k), LaneRecord(r)),
+                None => (None, LaneRecord::ZERO),
+            })
+            .unzip();
         Ok(BoundLights {
             lights: scene.lights,
+            kernels,
             records,
             isa: Isa::detect().unwrap_or(Isa::Portable),
             selector,
@@ -464,17 +471,19 @@ impl<'s> BoundLights<'s> {
         // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
         // mesh_light `light` pass); lanes without a kernel keep whatever they held.
         let mut with_kernel = 0u32;
+        let mut rows = [&LaneRecord::ZERO; LANES];
         let mut rest = if constant.is_some() { 0 } else { chosen };
         while rest != 0 {
             let lane = rest.trailing_zeros() as usize;
             rest &= rest - 1;
-            if let Some((k, r)) = &self.records[light[lane]] {
-                for (field, v) in records.iter_mut().zip(r) {
-                    field[lane] = *v;
-                }
+            if let Some(k) = self.kernels[light[lane]] {
+                rows[lane] = &self.records[light[lane]];
                 kernels[lane] = Some(k);
                 with_kernel |= 1 << lane;
             }
+        }
+        if with_kernel != 0 {
+            gather_records(self.isa, &rows, records);
         }
         let mut rest = with_kernel;
         while rest != 0 {
