@@ -30,6 +30,15 @@ impl Sphere {
         if disc < 0.0 {
             return None;
         }
+        let tmax = ray.tmax as f64;
+        // The segment's point nearest the centre, at t = min(b, tmax) when b ≥ 0: outside the
+        // sphere, the whole segment is. This settles the shadow rays aimed at the sphere (their
+        // tmax ends short of its near side, before b) without the square root and division of
+        // the roots. (With b < 0 it is the line's nearest point, inside: no early answer.)
+        let near = f + dir * b.min(tmax);
+        if near.length_squared() > r2 {
+            return None;
+        }
         let c = f.length_squared() - r2;
         let q = b + b.signum() * disc.sqrt();
         if q == 0.0 {
@@ -39,7 +48,6 @@ impl Sphere {
             let x = c / q;
             if x < q { (x, q) } else { (q, x) }
         };
-        let tmax = ray.tmax as f64;
         let t = if t0 > 0.0 && t0 < tmax {
             t0
         } else if t1 > 0.0 && t1 < tmax {
@@ -87,6 +95,19 @@ impl Sphere {
             // Every lane misses (most shadow rays pass a sphere by): nothing more to compute.
             return (0, [0.0; WIDTH]);
         }
+        // f32 → f64 is exact, so comparisons in f64 are the f32 ones.
+        let tm = D::from_f32(tmax);
+        let to = b.min(tm);
+        let near = [
+            f[0].add(dir[0].mul(to)),
+            f[1].add(dir[1].mul(to)),
+            f[2].add(dir[2].mul(to)),
+        ];
+        hit &= !r2.lt(dot3(near, near));
+        if hit == 0 {
+            // Every segment ends short of the sphere (shadow rays aimed at it).
+            return (0, [0.0; WIDTH]);
+        }
         let c = dot3(f, f).sub(r2);
         // b.signum(): −1 where the sign bit is set (−0.0 included).
         let sign = D::select(b.sign(), D::splat(-1.0), D::splat(1.0));
@@ -95,8 +116,6 @@ impl Sphere {
         let x = c.div(D::select(hit, q, D::splat(1.0)));
         let near = x.lt(q);
         let (t0, t1) = (D::select(near, x, q), D::select(near, q, x));
-        // f32 → f64 is exact, so comparisons in f64 are the f32 ones.
-        let tm = D::from_f32(tmax);
         let first = zero.lt(t0) & t0.lt(tm);
         let second = zero.lt(t1) & t1.lt(tm);
         hit &= first | second;
@@ -222,6 +241,54 @@ mod tests {
         assert!(
             hits > total / 5 && hits < total * 4 / 5,
             "{hits} of {total}"
+        );
+    }
+
+    /// Segments that end short of the sphere miss and chords through it hit, whatever their
+    /// ends: shadow rays aimed at points of the sphere stopping just before them (the early
+    /// answer from the segment's nearest point), chords whose both ends lie outside (the nearest
+    /// point is then inside, t = b, not the end), and segments ending inside. The reference is
+    /// the textbook geometry in f64: the nearest point of the segment to the centre.
+    #[test]
+    fn segments_short_of_the_sphere_miss_and_chords_hit() {
+        let s = Sphere {
+            center: Vec3::new(0.4, 1.0, -2.0),
+            radius: 0.8,
+        };
+        let mut rng = SampleStream::new(9, 2, 7, 1);
+        let (mut short, mut chords) = (0, 0);
+        for k in 0..20_000 {
+            let o = s.center + sample_uniform_sphere(rng.next_2d()) * (1.0 + 5.0 * rng.next_1d());
+            let q = s.center + sample_uniform_sphere(rng.next_2d()) * s.radius;
+            let (d, dist) = ((q - o).normalize(), (q - o).length());
+            // Ends 1e-3 short of q (a shadow ray), or past it by up to a diameter (a chord when q
+            // is on the near side), or anywhere before it.
+            let tmax = match k % 3 {
+                0 => dist * (1.0 - 1e-3),
+                1 => dist + 2.0 * s.radius * rng.next_1d(),
+                _ => dist * rng.next_1d(),
+            };
+            let (of, df, c) = (o.as_dvec3(), d.as_dvec3(), s.center.as_dvec3());
+            let t_near = (c - of).dot(df).clamp(0.0, tmax as f64);
+            let gap = (of + df * t_near - c).length() - s.radius as f64;
+            if gap.abs() < 1e-4 {
+                continue; // within rounding of grazing: either answer is right
+            }
+            let got = s.intersect(&Ray::new(o, d, tmax));
+            assert_eq!(
+                got.is_some(),
+                gap < 0.0,
+                "case {k}: gap {gap:e}, tmax {tmax}"
+            );
+            short += (gap > 0.0 && (c - of).dot(df) > tmax as f64) as usize;
+            chords +=
+                (gap < 0.0 && (of + df * tmax as f64 - c).length() > s.radius as f64) as usize;
+        }
+        // Both kinds are exercised: a segment ending short of the sphere and a chord with both
+        // ends outside (which the end point alone would call a miss).
+        assert!(
+            short > 1000 && chords > 1000,
+            "{short} short, {chords} chords"
         );
     }
 
