@@ -198,8 +198,21 @@ mod tests {
             // more away from the centre, at right angles to it, radius 0.7), the kernel's early
             // exit.
             let away = round % 10 == 9;
+            // Every tenth other packet holds shadow rays aimed at points of the sphere's side
+            // facing them (within 30° of the origin's direction, inside the visible cap of at
+            // least 45°), each ending 1e-3 short of its point: the second early exit.
+            let short = round % 10 == 8;
             for (l, tmax_l) in tmax.iter_mut().enumerate() {
                 let n = sample_uniform_sphere(rng.next_2d());
+                if short {
+                    let o = s.center + n * (1.0 + 4.0 * rng.next_1d());
+                    let q = s.center
+                        + (n + 0.5 * sample_uniform_sphere(rng.next_2d())).normalize() * s.radius;
+                    let tm = (q - o).length() * (1.0 - 1e-3);
+                    rays.set(l, &Ray::new(o, (q - o).normalize(), tm));
+                    *tmax_l = tm;
+                    continue;
+                }
                 let o = match (round + l) % 5 {
                     _ if away => s.center + n * (1.0 + 4.0 * rng.next_1d()),
                     0 => s.center + n * (s.radius + 1e-6),

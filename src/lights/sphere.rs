@@ -1,7 +1,8 @@
 //! Spherical area light emitting radiance L on both faces.
 //! Cone sampling: uniform over the solid angle the sphere subtends (pbrt-v4 `Sphere::Sample`;
-//! point placed analytically after Akalin 2015, no ray cast), pdf 1/(2π(1 - cos θmax)) with
-//! 1 - cos θmax computed stably. From inside the sphere the cone is undefined and the
+//! the point placed analytically as there, no ray cast, but by the ray–sphere root and the
+//! law of sines rather than Akalin 2015's cos α: see `sample_cone`), pdf
+//! 1/(2π(1 - cos θmax)) with 1 - cos θmax computed stably. From inside the sphere the cone is undefined and the
 //! sampler switches to uniform area sampling over the whole sphere, converted to solid angle.
 
 use super::bounds::{Bounds, LightBounds};
@@ -438,8 +439,10 @@ fn cone_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
         .add(to_c[2].mul(to_c[2]));
     let inside = a & d2.le(r2);
     let outside = a & !inside;
-    // Lanes inside take 2r² + 1 > r² instead, so that no lane divides by zero or takes a
-    // square root of a negative number; their results are not used.
+    // Lanes of `a` inside take 2r² + 1 > r² instead, so that none of them divides by zero or
+    // takes a square root of a negative number; their results are not used. (Lanes outside
+    // `a` may hold another light's record, or none (r = 0): whatever they compute is
+    // discarded by `keep`.)
     let one = D::splat(1.0);
     let d2 = D::select(inside, D::splat(2.0).mul(r2).add(one), d2);
     let dc = d2.sqrt();

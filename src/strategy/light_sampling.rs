@@ -469,7 +469,8 @@ impl<'s> BoundLights<'s> {
         // constants).
         let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
         // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
-        // mesh_light `light` pass); lanes without a kernel keep whatever they held.
+        // mesh_light `light` pass); lanes without a kernel get the zero record, which no kernel
+        // reads (each samples only its own lanes).
         let mut with_kernel = 0u32;
         let mut rows = [&LaneRecord::ZERO; LANES];
         let mut rest = if constant.is_some() { 0 } else { chosen };
