@@ -1,8 +1,8 @@
 //! Spherical area light emitting radiance L on both faces.
 //! Cone sampling: uniform over the solid angle the sphere subtends (pbrt-v4 `Sphere::Sample`;
 //! the point placed analytically as there, no ray cast, but by the ray–sphere root and the
-//! law of sines rather than Akalin 2015's cos α: see `sample_cone`), pdf
-//! 1/(2π(1 - cos θmax)) with 1 - cos θmax computed stably. From inside the sphere the cone is undefined and the
+//! law of sines rather than Akalin 2015's cos α: see `sample_cone`), pdf 1/(2π(1 - cos θmax))
+//! with 1 - cos θmax computed stably. From inside the sphere the cone is undefined and the
 //! sampler switches to uniform area sampling over the whole sphere, converted to solid angle.
 
 use super::bounds::{Bounds, LightBounds};

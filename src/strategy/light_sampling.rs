@@ -91,11 +91,12 @@ impl LightSampling {
 /// methods resolved once for this scene and integrand.
 pub struct BoundLights<'s> {
     pub lights: &'s LightSet,
-    /// Each light's kernel over lanes and its record for these methods
-    /// ([`Light::lane_record`]), asked once at bind: a packet reads a lane's record from here
-    /// instead of a dynamic call per lane (5 % of a mesh_light pass; docs/tracer.md, stop 47).
+    /// Each light's kernel over lanes for these methods ([`Light::lane_record`]), asked once
+    /// at bind: a packet reads a lane's kernel and record from here instead of a dynamic call
+    /// per lane (5 % of a mesh_light pass; docs/tracer.md, stop 47).
     kernels: Vec<Option<&'static LaneKernel>>,
-    /// The records, one cache line each ([`LaneRecord::ZERO`] for lights without a kernel).
+    /// Each light's record, one cache line each, read whole by [`gather_records`]
+    /// ([`LaneRecord::ZERO`] for lights without a kernel).
     records: Vec<LaneRecord>,
     pub selector: &'s dyn LightSelector,
     pub methods: LightMethods,
