@@ -39,14 +39,18 @@ pub struct HierarchicalWarp {
 #[repr(C, align(64))]
 struct Line([[f32; 4]; 4]);
 
-/// The chosen atlas texels of N lanes, (column, row), and the offsets (du, dv) ∈ [0, 1)²
-/// inside them.
-pub struct WarpLanes<V, const N: usize> {
-    pub col: [u32; N],
-    pub row: [u32; N],
+/// The chosen atlas texels of N lanes, (column, row) as whole numbers in f32 (exact: see
+/// [`HierarchicalWarp::new`]), and the offsets (du, dv) ∈ [0, 1)² inside them.
+pub struct WarpLanes<V> {
+    pub col: V,
+    pub row: V,
     pub du: V,
     pub dv: V,
 }
+
+/// The most texels an atlas may have: the descent's indices are whole numbers in f32, exact
+/// up to 2²⁴.
+const EXACT_F32: usize = 1 << 24;
 
 impl HierarchicalWarp {
     /// `weights` is the atlas (tiles·n wide, n high, row-major), non-negative; None when all
@@ -94,6 +98,13 @@ impl HierarchicalWarp {
                 pyramid.extend(quads(level));
             }
         }
+        // The descent does its index arithmetic in f32 lanes: quad numbers (below 4·block per
+        // tile, at most n² for n ≥ 2) and texel numbers, both below the atlas's texel count.
+        // The representations' tile sides are constants (`Repr::default_tile`), far below.
+        assert!(
+            tiles * n * n <= EXACT_F32,
+            "hierarchical warping: an atlas of {tiles} tiles of side {n} is past f32's whole numbers"
+        );
         (running > 0.0).then_some(HierarchicalWarp {
             n,
             tile_cdf,
@@ -104,78 +115,93 @@ impl HierarchicalWarp {
 
     /// (column, row) of the chosen atlas texel and the offsets (du, dv) ∈ [0, 1)² inside it.
     pub fn sample(&self, u: [f32; 2]) -> ((usize, usize), [f32; 2]) {
-        let s = self.sample_lanes::<f32, 1>(u[0], u[1]);
-        ((s.col[0] as usize, s.row[0] as usize), [s.du, s.dv])
+        let s = self.sample_lanes::<f32, 1>(u[0], u[1], |_, _| {});
+        ((s.col as usize, s.row as usize), [s.du, s.dv])
     }
 
-    /// [`Self::sample`] of N lanes at once, the same operations in the same order.
+    /// [`Self::sample`] of N lanes at once, the same operations in the same order. Indices
+    /// are whole numbers in f32 lanes (exact below 2²⁴, which `new` checks), so a level's step
+    /// is a few vector operations; only the quads' addresses leave the lanes. `block` sees,
+    /// before the last level's splits, the atlas (column, row) of each lane's 2×2 block of
+    /// texels, one of which the last level chooses: time to fetch what the caller will read
+    /// of them.
     #[inline(always)]
-    pub fn sample_lanes<V: Vector<N>, const N: usize>(&self, u0: V, u1: V) -> WarpLanes<V, N> {
+    pub fn sample_lanes<V: Vector<N>, const N: usize>(
+        &self,
+        u0: V,
+        u1: V,
+        mut block: impl FnMut(V, V),
+    ) -> WarpLanes<V> {
         let (mut u0, mut u1) = (u0, u1);
         let tiles = self.tile_cdf.len() - 1;
-        let mut tile = [0usize; N];
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let mut tile = zero;
         if tiles > 1 {
             // The tile whose cumulative interval holds u₀·total: tile_cdf[t] ≤ target <
-            // tile_cdf[t + 1], so its width is positive (u₀ < 1 makes target < total).
-            let target = u0.mul(V::splat(self.tile_cdf[tiles]));
+            // tile_cdf[t + 1], so its width is positive (u₀ < 1 makes target < total). The
+            // sums passed are a prefix of the sorted list: lo is the last of them, hi the
+            // first sum not passed.
+            let total = self.tile_cdf[tiles];
+            let target = u0.mul(V::splat(total));
+            let (mut lo, mut hi) = (zero, V::splat(total));
             for &c in &self.tile_cdf[1..tiles] {
                 let past = V::splat(c).le(target);
-                for (i, t) in tile.iter_mut().enumerate() {
-                    *t += (past >> i & 1) as usize;
-                }
+                tile = tile.add(V::select(past, one, zero));
+                lo = V::select(past, V::splat(c), lo);
             }
-            let (mut lo, mut hi) = ([0.0f32; N], [0.0f32; N]);
-            for i in 0..N {
-                lo[i] = self.tile_cdf[tile[i]];
-                hi[i] = self.tile_cdf[tile[i] + 1];
+            for &c in self.tile_cdf[1..tiles].iter().rev() {
+                hi = V::select(V::splat(c).le(target), hi, V::splat(c));
             }
-            let (lo, hi) = (V::load(&lo), V::load(&hi));
             u0 = target
                 .sub(lo)
                 .div(hi.sub(lo))
                 .min(V::splat(ONE_MINUS_EPSILON));
         }
-        let (mut x, mut y) = ([0u32; N], [0u32; N]);
-        // `m` is the Morton index of the node whose quad this step reads, among the nodes of
-        // side `half` (the parent level's); `line` is its level's first line.
-        let mut m = [0usize; N];
+        // Quad q of the pyramid is quad q % 4 of line q / 4. `m` is the Morton index of the
+        // node whose quad this step reads, among the nodes of side `half` (the parent
+        // level's); `line` is its level's first line, so the quad is 4·(tile's first line +
+        // line) + m.
+        let first = tile.mul(V::splat((4 * self.block) as f32));
+        let (mut x, mut y, mut m) = (zero, zero, zero);
         let (mut half, mut line) = (1usize, 0usize);
+        let mut at = [0u32; N];
         while half < self.n {
-            let mut at = [0usize; N];
-            for i in 0..N {
-                at[i] = tile[i] * self.block + line + m[i] / 4;
-            }
             // The next level's line for this node's children (whichever the splits choose).
             let next = line + (half * half).div_ceil(4);
             if 2 * half < self.n {
-                for i in 0..N {
-                    crate::simd::prefetch(
-                        self.pyramid
-                            .as_ptr()
-                            .wrapping_add(tile[i] * self.block + next + m[i]),
-                    );
+                first
+                    .add(V::splat((4 * next) as f32))
+                    .add(m.mul(V::splat(4.0)))
+                    .trunc_u32(&mut at);
+                for &q in &at {
+                    crate::simd::prefetch(self.pyramid.as_ptr().wrapping_add(q as usize / 4));
                 }
             }
-            let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at, &m);
+            first
+                .add(V::splat((4 * line) as f32))
+                .add(m)
+                .trunc_u32(&mut at);
+            if 2 * half == self.n {
+                let two = V::splat(2.0);
+                block(
+                    x.add(tile.mul(V::splat((self.n / 2) as f32))).mul(two),
+                    y.mul(two),
+                );
+            }
+            let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at);
             let (right, u0n) = split(c00.add(c01), c10.add(c11), u0);
             let (top, bottom) = (V::select(right, c10, c00), V::select(right, c11, c01));
             let (down, u1n) = split(top, bottom, u1);
-            for i in 0..N {
-                let (r, d) = (right >> i & 1, down >> i & 1);
-                x[i] = 2 * x[i] + r;
-                y[i] = 2 * y[i] + d;
-                m[i] = 4 * m[i] + (r + 2 * d) as usize;
-            }
+            let (r, d) = (V::select(right, one, zero), V::select(down, one, zero));
+            x = x.add(x).add(r);
+            y = y.add(y).add(d);
+            m = m.mul(V::splat(4.0)).add(r).add(d.add(d));
             (u0, u1) = (u0n, u1n);
             line = next;
             half *= 2;
         }
-        let mut col = x;
-        for i in 0..N {
-            col[i] += (tile[i] * self.n) as u32;
-        }
         WarpLanes {
-            col,
+            col: x.add(tile.mul(V::splat(self.n as f32))),
             row: y,
             du: u0,
             dv: u1,
@@ -183,11 +209,13 @@ impl HierarchicalWarp {
     }
 }
 
-/// Lane i's quad `m[i] % 4` of line `at[i]`, as four vectors, one per texel of the quad
-/// ([`Vector::load_records`]: each quad read whole, transposed in registers).
+/// Lane i's quad `q[i]` (quad q % 4 of line q / 4), as four vectors, one per texel of the
+/// quad ([`Vector::load_records`]: each quad read whole, transposed in registers).
 #[inline(always)]
-fn gather<V: Vector<N>, const N: usize>(lines: &[Line], at: &[usize; N], m: &[usize; N]) -> [V; 4] {
-    V::load_records(&std::array::from_fn(|i| &lines[at[i]].0[m[i] % 4]))
+fn gather<V: Vector<N>, const N: usize>(lines: &[Line], q: &[u32; N]) -> [V; 4] {
+    V::load_records(&std::array::from_fn(|i| {
+        &lines[q[i] as usize / 4].0[q[i] as usize % 4]
+    }))
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in
@@ -278,10 +306,12 @@ mod tests {
         })
     }
 
-    /// Texels are chosen by weight, black ones never, with offsets in [0, 1).
+    /// Texels are chosen by weight, black ones never, with offsets in [0, 1). Five tiles of
+    /// different sums: a tile choice that took the last unpassed sum for the interval's end,
+    /// not the first, passes with two tiles and with three whose middle one is black.
     #[test]
     fn texels_are_chosen_by_weight() {
-        for (tiles, n) in [(1, 8), (2, 8), (3, 4)] {
+        for (tiles, n) in [(1, 8), (2, 8), (3, 4), (5, 4)] {
             let w = atlas(tiles, n);
             let warp = HierarchicalWarp::new(&w, tiles, n).unwrap();
             assert_eq!(frequency_mismatch(&warp, &w), None, "tiles {tiles} n {n}");
@@ -315,16 +345,19 @@ mod tests {
     struct Lanes16<'a>(&'a HierarchicalWarp, [f32; WIDTH], [f32; WIDTH]);
 
     impl Kernel for Lanes16<'_> {
-        type Out = ([u32; WIDTH], [u32; WIDTH], [f32; WIDTH], [f32; WIDTH]);
+        type Out = ([f32; WIDTH], [f32; WIDTH], [f32; WIDTH], [f32; WIDTH]);
         #[inline(always)]
         fn run<L: Lanes>(self) -> Self::Out {
-            let s = self
-                .0
-                .sample_lanes::<L::V, WIDTH>(L::V::load(&self.1), L::V::load(&self.2));
-            let (mut du, mut dv) = ([0.0; WIDTH], [0.0; WIDTH]);
-            s.du.store(&mut du);
-            s.dv.store(&mut dv);
-            (s.col, s.row, du, dv)
+            let s = self.0.sample_lanes::<L::V, WIDTH>(
+                L::V::load(&self.1),
+                L::V::load(&self.2),
+                |_, _| {},
+            );
+            let mut out = [[0.0; WIDTH]; 4];
+            for (v, o) in [s.col, s.row, s.du, s.dv].into_iter().zip(&mut out) {
+                v.store(o);
+            }
+            out.into()
         }
     }
 
@@ -357,12 +390,17 @@ mod tests {
                         let ((c, r), [a, b]) = warp.sample([u[0][lane], u[1][lane]]);
                         assert_eq!(
                             (
-                                col[lane] as usize,
-                                row[lane] as usize,
+                                col[lane].to_bits(),
+                                row[lane].to_bits(),
                                 du[lane].to_bits(),
                                 dv[lane].to_bits()
                             ),
-                            (c, r, a.to_bits(), b.to_bits()),
+                            (
+                                (c as f32).to_bits(),
+                                (r as f32).to_bits(),
+                                a.to_bits(),
+                                b.to_bits()
+                            ),
                             "{isa:?} tiles {tiles} n {n} lane {lane}"
                         );
                     }
