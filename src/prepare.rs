@@ -107,7 +107,7 @@ impl SceneView<'_> {
     /// lanes where the representation has a kernel, with the same bits).
     pub fn add_env_radiance(&self, isa: Isa, dirs: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
         if let Some(env) = self.lights.environment() {
-            env.map(self.env).texels.add_lookups(isa, dirs, mask, out);
+            env.map(self.env).add_lookups(isa, dirs, mask, out);
         }
     }
 

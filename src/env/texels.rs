@@ -93,35 +93,6 @@ impl TexelMap {
         self.texels[self.index(self.repr.dir_to_uv(w))]
     }
 
-    /// [`Self::lookup`] of the directions `w` of lanes `mask`, added to `out`: over lanes for
-    /// lat/long maps (bit for bit), lane by lane for the others.
-    pub fn add_lookups(&self, isa: Isa, w: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
-        if self.repr != Repr::LatLong {
-            for (lane, o) in out.iter_mut().enumerate() {
-                if mask >> lane & 1 != 0 {
-                    *o += self.lookup(w.get(lane));
-                }
-            }
-            return;
-        }
-        struct Index<'a>(&'a TexelMap, &'a Soa3);
-        impl Kernel for Index<'_> {
-            type Out = [usize; WIDTH];
-            #[inline(always)]
-            fn run<L: Lanes>(self) -> [usize; WIDTH] {
-                let w = V3::<L::V>::load(self.1);
-                let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
-                self.0.index_lanes::<L::V, WIDTH>(u, v)
-            }
-        }
-        let k = simd::run(isa, Index(self, w));
-        for (lane, o) in out.iter_mut().enumerate() {
-            if mask >> lane & 1 != 0 {
-                *o += self.texels[k[lane]];
-            }
-        }
-    }
-
     /// Atlas centre of texel k.
     fn centre(&self, k: usize) -> [f32; 2] {
         [
@@ -342,6 +313,39 @@ impl ImportanceMap {
         Some(out)
     }
 
+    /// [`TexelMap::lookup`] of the directions `w` of lanes `mask`, added to `out`: over lanes
+    /// for lat/long maps (bit for bit), lane by lane for the others. Over lanes the radiance is
+    /// read from the records, so a pdf of the same direction ([`Self::pdf_lanes`], the MIS
+    /// weight of an escaped BSDF sample) finds its density in the line already read.
+    pub fn add_lookups(&self, isa: Isa, w: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
+        let t = &self.texels;
+        if t.repr != Repr::LatLong {
+            for (lane, o) in out.iter_mut().enumerate() {
+                if mask >> lane & 1 != 0 {
+                    *o += t.lookup(w.get(lane));
+                }
+            }
+            return;
+        }
+        struct Index<'a>(&'a TexelMap, &'a Soa3);
+        impl Kernel for Index<'_> {
+            type Out = [usize; WIDTH];
+            #[inline(always)]
+            fn run<L: Lanes>(self) -> [usize; WIDTH] {
+                let w = V3::<L::V>::load(self.1);
+                let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
+                self.0.index_lanes::<L::V, WIDTH>(u, v)
+            }
+        }
+        let k = simd::run(isa, Index(t, w));
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0 {
+                let [r, g, b, _] = self.record[k[lane]];
+                *o += Vec3::new(r, g, b);
+            }
+        }
+    }
+
     /// Solid-angle pdf of direction `w`: 0 for a black map, in black texels and at J = 0.
     pub fn pdf(&self, w: Vec3) -> f32 {
         let uv = self.texels.repr.dir_to_uv(w);
@@ -539,7 +543,7 @@ mod tests {
     fn lookups_over_lanes_are_the_scalar_ones_on_every_isa() {
         let mut rng = SampleStream::new(4, 1, 2, 3);
         for repr in Repr::ALL {
-            let m = map(repr);
+            let m = ImportanceMap::new(map(repr));
             for round in 0..300 {
                 let (w, mask) = directions(&mut rng, round);
                 for isa in Isa::available() {
@@ -547,7 +551,7 @@ mod tests {
                     m.add_lookups(isa, &w, mask, &mut out);
                     for (lane, o) in out.iter().enumerate() {
                         let want = if mask >> lane & 1 != 0 {
-                            Vec3::splat(0.25) + m.lookup(w.get(lane))
+                            Vec3::splat(0.25) + m.texels.lookup(w.get(lane))
                         } else {
                             Vec3::splat(0.25)
                         };
