@@ -61,6 +61,14 @@ impl HierarchicalWarp {
             n.is_power_of_two(),
             "hierarchical warping needs a power-of-two tile"
         );
+        // The descent does its index arithmetic in f32 lanes: quad numbers (below 4·block per
+        // tile, at most n² for n ≥ 2) and texel numbers, both below the atlas's texel count.
+        // The default atlases have at most 12·128² texels (HEALPix); the χ² command's `tile`
+        // parameter allows sides up to 512, 12·512² ≈ 3.1 M: all below 2²⁴.
+        assert!(
+            tiles * n * n <= EXACT_F32,
+            "hierarchical warping: an atlas of {tiles} tiles of side {n} is past f32's whole numbers"
+        );
         let width = tiles * n;
         // One line for the root's quad (padded), then a quarter of each level's quads.
         let block = if n > 1 { 1 + (n * n / 4 - 1) / 3 } else { 0 };
@@ -98,13 +106,6 @@ impl HierarchicalWarp {
                 pyramid.extend(quads(level));
             }
         }
-        // The descent does its index arithmetic in f32 lanes: quad numbers (below 4·block per
-        // tile, at most n² for n ≥ 2) and texel numbers, both below the atlas's texel count.
-        // The representations' tile sides are constants (`Repr::default_tile`), far below.
-        assert!(
-            tiles * n * n <= EXACT_F32,
-            "hierarchical warping: an atlas of {tiles} tiles of side {n} is past f32's whole numbers"
-        );
         (running > 0.0).then_some(HierarchicalWarp {
             n,
             tile_cdf,
@@ -121,16 +122,16 @@ impl HierarchicalWarp {
 
     /// [`Self::sample`] of N lanes at once, the same operations in the same order. Indices
     /// are whole numbers in f32 lanes (exact below 2²⁴, which `new` checks), so a level's step
-    /// is a few vector operations; only the quads' addresses leave the lanes. `block` sees,
-    /// before the last level's splits, the atlas (column, row) of each lane's 2×2 block of
-    /// texels, one of which the last level chooses: time to fetch what the caller will read
-    /// of them.
+    /// is a few vector operations; only the quads' addresses leave the lanes.
+    /// `before_last_level` sees, before the last level's splits, the atlas (column, row) of
+    /// each lane's 2×2 block of texels (both even), one of which the last level chooses: time
+    /// to fetch what the caller will read of them. A tile of side 1 has no levels, and no call.
     #[inline(always)]
     pub fn sample_lanes<V: Vector<N>, const N: usize>(
         &self,
         u0: V,
         u1: V,
-        mut block: impl FnMut(V, V),
+        mut before_last_level: impl FnMut(V, V),
     ) -> WarpLanes<V> {
         let (mut u0, mut u1) = (u0, u1);
         let tiles = self.tile_cdf.len() - 1;
@@ -183,7 +184,7 @@ impl HierarchicalWarp {
                 .trunc_u32(&mut at);
             if 2 * half == self.n {
                 let two = V::splat(2.0);
-                block(
+                before_last_level(
                     x.add(tile.mul(V::splat((self.n / 2) as f32))).mul(two),
                     y.mul(two),
                 );
@@ -311,7 +312,7 @@ mod tests {
     /// not the first, passes with two tiles and with three whose middle one is black.
     #[test]
     fn texels_are_chosen_by_weight() {
-        for (tiles, n) in [(1, 8), (2, 8), (3, 4), (5, 4)] {
+        for (tiles, n) in [(1, 8), (2, 8), (3, 4), (5, 4), (4, 2), (3, 1)] {
             let w = atlas(tiles, n);
             let warp = HierarchicalWarp::new(&w, tiles, n).unwrap();
             assert_eq!(frequency_mismatch(&warp, &w), None, "tiles {tiles} n {n}");
@@ -345,20 +346,67 @@ mod tests {
     struct Lanes16<'a>(&'a HierarchicalWarp, [f32; WIDTH], [f32; WIDTH]);
 
     impl Kernel for Lanes16<'_> {
-        type Out = ([f32; WIDTH], [f32; WIDTH], [f32; WIDTH], [f32; WIDTH]);
+        /// (column, row, du, dv) of each lane, and the (column, row) `before_last_level` saw
+        /// (None when it was not called; a second call fails).
+        type Out = ([[f32; WIDTH]; 4], Option<[[f32; WIDTH]; 2]>);
         #[inline(always)]
         fn run<L: Lanes>(self) -> Self::Out {
+            let mut block = None;
             let s = self.0.sample_lanes::<L::V, WIDTH>(
                 L::V::load(&self.1),
                 L::V::load(&self.2),
-                |_, _| {},
+                |col, row| {
+                    let mut b = [[0.0; WIDTH]; 2];
+                    col.store(&mut b[0]);
+                    row.store(&mut b[1]);
+                    assert!(block.replace(b).is_none(), "called twice");
+                },
             );
             let mut out = [[0.0; WIDTH]; 4];
             for (v, o) in [s.col, s.row, s.du, s.dv].into_iter().zip(&mut out) {
                 v.store(o);
             }
-            out.into()
+            (out, block)
         }
+    }
+
+    /// `before_last_level` sees each lane's 2×2 block of texels, the chosen texel's column
+    /// and row with their lowest bit cleared, on every ISA; a tile of side 1 (no levels) makes
+    /// no call. Control: the samples include texels whose block differs from the level
+    /// above's (column or row with bit 1 set), so a callback handed that block fails.
+    #[test]
+    fn the_last_levels_block_holds_the_chosen_texel() {
+        let block_of = |c: usize, r: usize, bits: usize| [(c >> bits << bits), (r >> bits << bits)];
+        let mut discriminating = 0;
+        for (tiles, n) in [(1, 8), (2, 16), (12, 8), (4, 2), (3, 1)] {
+            let warp = HierarchicalWarp::new(&atlas(tiles, n), tiles, n).unwrap();
+            let mut rng = SampleStream::new(2, 7, 1, 8);
+            for _ in 0..50 {
+                let u: [[f32; WIDTH]; 2] = {
+                    let pairs: [[f32; 2]; WIDTH] = std::array::from_fn(|_| rng.next_2d());
+                    [pairs.map(|p| p[0]), pairs.map(|p| p[1])]
+                };
+                for isa in Isa::available() {
+                    let ([col, row, _, _], block) =
+                        crate::simd::run(isa, Lanes16(&warp, u[0], u[1]));
+                    let Some([bc, br]) = block else {
+                        assert_eq!(n, 1, "{isa:?} tiles {tiles} n {n}: no call");
+                        continue;
+                    };
+                    assert!(n > 1, "{isa:?} tiles {tiles}: a call without levels");
+                    for lane in 0..WIDTH {
+                        let (c, r) = (col[lane] as usize, row[lane] as usize);
+                        let got = [bc[lane] as usize, br[lane] as usize];
+                        assert_eq!(got, block_of(c, r, 1), "{isa:?} tiles {tiles} n {n}");
+                        discriminating += (block_of(c, r, 2) != got) as usize;
+                    }
+                }
+            }
+        }
+        assert!(
+            discriminating > 100,
+            "{discriminating} lanes tell the levels apart"
+        );
     }
 
     /// Sixteen lanes at once are the scalar samples, bit for bit, on every ISA, with u at 0,
@@ -385,7 +433,7 @@ mod tests {
                     };
                 }
                 for isa in Isa::available() {
-                    let (col, row, du, dv) = crate::simd::run(isa, Lanes16(&warp, u[0], u[1]));
+                    let ([col, row, du, dv], _) = crate::simd::run(isa, Lanes16(&warp, u[0], u[1]));
                     for lane in 0..WIDTH {
                         let ((c, r), [a, b]) = warp.sample([u[0][lane], u[1][lane]]);
                         assert_eq!(

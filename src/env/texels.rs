@@ -120,14 +120,21 @@ pub struct ImportanceMap {
     /// Per texel its radiance and its density over the atlas, (w_k / Σw) · texel count (the
     /// sum in f64), in one 16-byte record: the sampler over lanes reads one cache line per
     /// lane instead of three (radiance, density, weight). The density is positive exactly
-    /// where the weight is (it is at least the weight: Σw ≤ the count).
-    record: Vec<[f32; 4]>,
+    /// where the weight is (it is at least the weight: Σw ≤ the count). Four to a 64-byte
+    /// line, aligned, so the two records of a texel pair (even column) share a line (see
+    /// [`Self::record`]).
+    records: Vec<RecordLine>,
     /// ∫ luminance(L) dω over the sphere (≈ Σ weights / texel count, before scaling).
     pub luminance_integral: f64,
     /// None for a black map: nothing to sample.
     cdf: Option<MarginalConditional>,
     hier: Option<HierarchicalWarp>,
 }
+
+/// Four texel records in one cache line.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(64))]
+struct RecordLine([[f32; 4]; 4]);
 
 /// Environment samples of 16 lanes (structure of arrays); `valid` marks the lanes with one.
 #[derive(Clone, Copy, Debug, Default)]
@@ -160,40 +167,45 @@ impl ImportanceMap {
                 }
             })
             .collect();
-        let record = texels
-            .texels
-            .iter()
-            .zip(&density)
-            .map(|(l, &d)| [l.x, l.y, l.z, d])
-            .collect();
+        let mut records = vec![RecordLine::default(); texels.texels.len().div_ceil(4)];
+        for (k, (l, &d)) in texels.texels.iter().zip(&density).enumerate() {
+            records[k / 4].0[k % 4] = [l.x, l.y, l.z, d];
+        }
         let as_f64: Vec<f64> = weights.iter().map(|&w| w as f64).collect();
         let cdf = MarginalConditional::new(&as_f64, texels.width);
         let hier = HierarchicalWarp::new(&weights, texels.repr.tiles(), texels.height);
         ImportanceMap {
             luminance_integral: exact.iter().sum::<f64>() / count,
             weights,
-            record,
+            records,
             cdf,
             hier,
             texels,
         }
     }
 
-    /// Texel k's density over the atlas (see `record`).
+    /// Texel k's record: its radiance and density (see `records`).
+    #[inline(always)]
+    fn record(&self, k: usize) -> &[f32; 4] {
+        &self.records[k / 4].0[k % 4]
+    }
+
+    /// Texel k's density over the atlas (see `records`).
     #[inline(always)]
     fn density(&self, k: usize) -> f32 {
-        self.record[k][3]
+        self.record(k)[3]
     }
 
     /// The atlas points (u, v) ∈ [0, 1)² of N lanes' hierarchical samples, in f32. With
-    /// `records`, the two lines of records under each lane's last 2×2 block are prefetched
-    /// before the last level's splits (2 MB read at random: the read after the warp would
-    /// otherwise wait for them).
+    /// `records`, the two lines of records under each lane's last 2×2 block (a pair of
+    /// texels in each of two rows, a pair sharing a line) are prefetched before the last
+    /// level's splits (2 MB read at random: the read after the warp would otherwise wait for
+    /// them).
     #[inline(always)]
     fn hier_uv<V: Vector<N>, const N: usize>(
         hier: &HierarchicalWarp,
         t: &TexelMap,
-        records: Option<&[[f32; 4]]>,
+        records: Option<&[RecordLine]>,
         u0: V,
         u1: V,
     ) -> (V, V) {
@@ -204,9 +216,9 @@ impl ImportanceMap {
                 let mut k = [0u32; N];
                 row.mul(V::splat(t.width as f32)).add(col).trunc_u32(&mut k);
                 let p = records.as_ptr();
-                for k in k {
-                    crate::simd::prefetch(p.wrapping_add(k as usize));
-                    crate::simd::prefetch(p.wrapping_add(k as usize + t.width));
+                for k in k.map(|k| k as usize) {
+                    crate::simd::prefetch(p.wrapping_add(k / 4));
+                    crate::simd::prefetch(p.wrapping_add((k + t.width) / 4));
                 }
             }
         });
@@ -242,7 +254,7 @@ impl ImportanceMap {
         u1.store(&mut b);
         let (col, row, du, dv) = cdf.sample_lanes([a, b]);
         for i in 0..N {
-            crate::simd::prefetch(&self.record[row[i] * t.width + col[i]]);
+            crate::simd::prefetch(self.record(row[i] * t.width + col[i]));
         }
         for i in 0..N {
             [a[i], b[i]] = Self::cdf_uv(t, col[i], row[i], du[i], dv[i]);
@@ -295,7 +307,7 @@ impl ImportanceMap {
         let (u, v) = match sampler {
             EnvSampler::Cdf => self.cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, u0, u1),
             EnvSampler::Hierarchical => {
-                Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, Some(&self.record), u0, u1)
+                Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, Some(&self.records), u0, u1)
             }
         };
         let k = t.index_lanes::<V, WIDTH>(u, v);
@@ -303,10 +315,10 @@ impl ImportanceMap {
         let (x, y, z) = latlong::uv_to_dir_lanes(u, v);
         let mut out = EnvLanes::default();
         V3 { x, y, z }.store(&mut out.wi);
-        let [r, g, b, density] = V::load_records(&std::array::from_fn(|i| &self.record[k[i]]));
+        let [r, g, b, density] = V::load_records(&std::array::from_fn(|i| self.record(k[i])));
         V3 { x: r, y: g, z: b }.store(&mut out.radiance);
         let zero = V::splat(0.0);
-        // As the scalar sampler's weight > 0 (see `record`).
+        // As the scalar sampler's weight > 0 (see `records`).
         let positive = zero.lt(density);
         out.valid = active & positive & !jac.le(zero);
         density.div(jac).store(&mut out.pdf);
@@ -340,7 +352,7 @@ impl ImportanceMap {
         let k = simd::run(isa, Index(t, w));
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0 {
-                let [r, g, b, _] = self.record[k[lane]];
+                let [r, g, b, _] = *self.record(k[lane]);
                 *o += Vec3::new(r, g, b);
             }
         }
