@@ -196,30 +196,27 @@ impl ImportanceMap {
         self.record(k)[3]
     }
 
-    /// The atlas points (u, v) ∈ [0, 1)² of N lanes' hierarchical samples, in f32. With
-    /// `records`, the two lines of records under each lane's last 2×2 block (a pair of
-    /// texels in each of two rows, a pair sharing a line) are prefetched before the last
-    /// level's splits (2 MB read at random: the read after the warp would otherwise wait for
-    /// them).
+    /// The atlas points (u, v) ∈ [0, 1)² of N lanes' hierarchical samples, in f32. The two
+    /// lines of records under each lane's last 2×2 block (a pair of texels in each of two
+    /// rows, a pair sharing a line) are prefetched before the last level's splits (2 MB read
+    /// at random: the read after the warp would otherwise wait for them).
     #[inline(always)]
     fn hier_uv<V: Vector<N>, const N: usize>(
+        &self,
         hier: &HierarchicalWarp,
-        t: &TexelMap,
-        records: Option<&[RecordLine]>,
         u0: V,
         u1: V,
     ) -> (V, V) {
+        let t = &self.texels;
         let s = hier.sample_lanes::<V, N>(u0, u1, |col, row| {
-            if let Some(records) = records {
-                // Texel numbers are whole f32s: the atlas has at most 2²⁴ texels (checked by
-                // `HierarchicalWarp::new`).
-                let mut k = [0u32; N];
-                row.mul(V::splat(t.width as f32)).add(col).trunc_u32(&mut k);
-                let p = records.as_ptr();
-                for k in k.map(|k| k as usize) {
-                    crate::simd::prefetch(p.wrapping_add(k / 4));
-                    crate::simd::prefetch(p.wrapping_add((k + t.width) / 4));
-                }
+            // Texel numbers are whole f32s: the atlas has at most 2²⁴ texels (checked by
+            // `HierarchicalWarp::new`).
+            let mut k = [0u32; N];
+            row.mul(V::splat(t.width as f32)).add(col).trunc_u32(&mut k);
+            let p = self.records.as_ptr();
+            for k in k.map(|k| k as usize) {
+                crate::simd::prefetch(p.wrapping_add(k / 4));
+                crate::simd::prefetch(p.wrapping_add((k + t.width) / 4));
             }
         });
         let below = V::splat(ONE_MINUS_EPSILON);
@@ -271,7 +268,7 @@ impl ImportanceMap {
                 Self::cdf_uv(t, col, row, du, dv)
             }
             EnvSampler::Hierarchical => {
-                let (u, v) = Self::hier_uv::<f32, 1>(self.hier.as_ref()?, t, None, u[0], u[1]);
+                let (u, v) = self.hier_uv::<f32, 1>(self.hier.as_ref()?, u[0], u[1]);
                 [u, v]
             }
         };
@@ -306,9 +303,7 @@ impl ImportanceMap {
         }
         let (u, v) = match sampler {
             EnvSampler::Cdf => self.cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, u0, u1),
-            EnvSampler::Hierarchical => {
-                Self::hier_uv::<V, WIDTH>(self.hier.as_ref()?, t, Some(&self.records), u0, u1)
-            }
+            EnvSampler::Hierarchical => self.hier_uv::<V, WIDTH>(self.hier.as_ref()?, u0, u1),
         };
         let k = t.index_lanes::<V, WIDTH>(u, v);
         let jac = latlong::jacobian_lanes(v);

@@ -35,8 +35,8 @@ impl Sphere {
         // sphere, the whole segment is. This settles the shadow rays aimed at the sphere (their
         // tmax ends short of its near side, before b) without the square root and division of
         // the roots. (With b < 0 it is the line's nearest point, inside: no early answer.)
-        let near = f + dir * b.min(tmax);
-        if near.length_squared() > r2 {
+        let nearest = f + dir * b.min(tmax);
+        if nearest.length_squared() > r2 {
             return None;
         }
         let c = f.length_squared() - r2;
@@ -98,12 +98,12 @@ impl Sphere {
         // f32 → f64 is exact, so comparisons in f64 are the f32 ones.
         let tm = D::from_f32(tmax);
         let to = b.min(tm);
-        let near = [
+        let nearest = [
             f[0].add(dir[0].mul(to)),
             f[1].add(dir[1].mul(to)),
             f[2].add(dir[2].mul(to)),
         ];
-        hit &= !r2.lt(dot3(near, near));
+        hit &= !r2.lt(dot3(nearest, nearest));
         if hit == 0 {
             // Every segment ends short of the sphere (shadow rays aimed at it).
             return (0, [0.0; WIDTH]);
