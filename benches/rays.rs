@@ -19,7 +19,7 @@
 //! chosen.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use dibench::harness::rays::{Subject, generate, measure, subjects};
+use dibench::harness::rays::{Packing, Subject, generate, measure, subjects};
 use dibench::prepare::PreparedScene;
 use dibench::scene::Scene;
 use dibench::simd::Isa;
@@ -62,7 +62,7 @@ fn hybrid_sweep() {
             .iter()
             .map(|&(n, l)| Subject::Packet(tr.clone().with_hybrid(n, l)))
             .collect();
-        let rows = measure(name, &sets, &subjects, 9, 1);
+        let rows = measure(name, &sets, &subjects, 9, 1, Packing::Tile);
         println!(
             "hybrid sweep, {name}, {}, {}²: Mrays/s (lane occupancy) per (node, leaf) switch",
             isa.name(),
@@ -104,7 +104,7 @@ fn frustum_sweep() {
                 .iter()
                 .map(|&k| Subject::Packet(tr.clone().with_frustum_children(k)))
                 .collect();
-            let rows = measure(name, &sets, &subjects, 9, 1);
+            let rows = measure(name, &sets, &subjects, 9, 1, Packing::Tile);
             let line: Vec<String> = rows
                 .iter()
                 .zip(&variants)
@@ -161,7 +161,7 @@ fn build_sweep() {
                 subjects.push(Subject::Packet(tr));
             }
         }
-        let rows = measure(name, &sets, &subjects, 7, 1);
+        let rows = measure(name, &sets, &subjects, 7, 1, Packing::Tile);
         println!(
             "build sweep, {name}, {}: Mrays/s per (preset/block cost)",
             isa.name()

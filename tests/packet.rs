@@ -7,7 +7,7 @@
 use dibench::film::Film;
 use dibench::geometry::Ray;
 use dibench::geometry::triangle::{Triangle, WatertightRay};
-use dibench::harness::rays::{self, Query};
+use dibench::harness::rays::{self, Packing, Query};
 use dibench::prepare::PreparedScene;
 use dibench::render::Renderer;
 use dibench::scene::Scene;
@@ -122,7 +122,9 @@ fn check_occluded(base: &ObvhsTracer, tr: &PacketTracer, p: &RayPacket, m: LaneM
 
 fn agree_on(sc: &PreparedScene, name: &str) {
     let base = ObvhsTracer::build(sc.world.geometry.clone());
-    let sets = rays::generate(sc, 48, 7);
+    // Both packings: a pixel's 16 samples are the render's packets, nearly one ray 16 times.
+    let mut sets = rays::generate(sc, 48, 7);
+    sets.extend(rays::generate_packed(sc, 48, 7, Packing::Pixel));
     let random = random_packets(sc, 400, 11);
     for isa in Isa::available() {
         let tr = PacketTracer::build(sc.world.geometry.clone(), isa).unwrap();
@@ -148,6 +150,59 @@ fn agree_on(sc: &PreparedScene, name: &str) {
             "{name}: too few hits to test anything: {tally:?}"
         );
     }
+}
+
+/// `rays --packets pixel`: packet i's camera rays are 16 samples of pixel i (row-major) of the
+/// quarter-size image (each direction, projected back onto the screen, lands in it), and a
+/// set holds as many rays as with tiles. Control: a tile's lanes span four pixels.
+#[test]
+fn pixel_packets_hold_one_pixels_samples() {
+    let sc = scene("cornell");
+    let cam = &sc.scene.camera;
+    let size = 48u32;
+    // Screen position of direction d in an image of side n (camera_ray's mapping inverted).
+    let screen = |d: Vec3, n: u32| {
+        let f = d.dot(cam.forward);
+        let sx = d.dot(cam.right) / f / cam.tan_half_fov_y;
+        let sy = d.dot(cam.up) / f / cam.tan_half_fov_y;
+        ((sx + 1.0) * 0.5 * n as f32, (1.0 - sy) * 0.5 * n as f32)
+    };
+    // Per packet, the pixel box its lanes' screen positions span (smallest and largest).
+    let spans = |packing: Packing, n: u32| -> Vec<[f32; 4]> {
+        let sets = rays::generate_packed(&sc, size, 3, packing);
+        let primary = sets.iter().find(|s| s.class == "primary").unwrap();
+        assert_eq!(primary.rays(), (size * size) as u64, "{packing:?}");
+        primary
+            .packets
+            .iter()
+            .zip(&primary.masks)
+            .map(|(p, &m)| {
+                let mut b = [f32::MAX, f32::MAX, f32::MIN, f32::MIN];
+                for l in (0..LANES).filter(|l| m >> l & 1 != 0) {
+                    let (x, y) = screen(p.get(l).dir, n);
+                    b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+                }
+                b
+            })
+            .collect()
+    };
+    let n = size / 4;
+    let pixels = spans(Packing::Pixel, n);
+    assert_eq!(pixels.len(), (n * n) as usize);
+    let slack = 1e-3;
+    for (i, b) in pixels.iter().enumerate() {
+        let (x, y) = ((i as u32 % n) as f32, (i as u32 / n) as f32);
+        assert!(
+            b[0] >= x - slack
+                && b[2] <= x + 1.0 + slack
+                && b[1] >= y - slack
+                && b[3] <= y + 1.0 + slack,
+            "packet {i} spans {b:?}, not pixel ({x}, {y})"
+        );
+    }
+    // Control: the tiles' lanes, in their own image, span four pixels in x and in y.
+    let tiles = spans(Packing::Tile, size);
+    assert!(tiles.iter().all(|b| b[2] - b[0] > 2.5 && b[3] - b[1] > 2.5));
 }
 
 #[test]

@@ -56,6 +56,7 @@ fn rays_writes_csv() {
         "backend",
         "isa",
         "ray_class",
+        "packets",
         "rays",
         "seconds",
         "mrays_per_s",
@@ -124,5 +125,38 @@ fn class_picks_the_ray_classes() {
         "{err}"
     );
     assert!(err.contains("shadow_area"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+/// `--packets pixel` packs one pixel's samples per packet and says so in every row (`tile`
+/// by default); an unknown packing is an error naming the flag and the known ones.
+#[test]
+fn packets_choose_the_packing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().to_str().unwrap();
+    for (args, want) in [(&[][..], "tile"), (&["--packets", "pixel"][..], "pixel")] {
+        let mut all = vec![
+            "rays", "cornell", "--out", out, "--size", "16", "--rounds", "1",
+        ];
+        all.extend_from_slice(args);
+        let (ok, err) = run(&all);
+        assert!(ok, "{err}");
+        let csv = std::fs::read_to_string(dir.path().join("cornell/rays.csv")).unwrap();
+        let col = csv
+            .lines()
+            .next()
+            .unwrap()
+            .split(',')
+            .position(|c| c == "packets")
+            .unwrap();
+        let rows: Vec<&str> = csv.lines().skip(1).collect();
+        assert!(!rows.is_empty());
+        for row in rows {
+            assert_eq!(row.split(',').nth(col), Some(want), "{csv}");
+        }
+    }
+    let (ok, err) = run(&["rays", "cornell", "--out", out, "--packets", "rows"]);
+    assert!(!ok, "an unknown packing was accepted");
+    assert!(err.contains("--packets") && err.contains("pixel"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
 }

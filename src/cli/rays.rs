@@ -36,6 +36,11 @@ pub struct RaysArgs {
     /// default: all four).
     #[arg(long, value_delimiter = ',')]
     pub class: Vec<String>,
+    /// What a packet's 16 camera rays are: `tile`, the centres of 4×4 pixels, or `pixel`, 16
+    /// jittered samples of one pixel of a (size/4)² image, as a render traces them (its
+    /// secondary rays then start within one pixel's footprint).
+    #[arg(long, value_enum, default_value_t = raysets::Packing::Tile)]
+    pub packets: raysets::Packing,
 }
 
 fn parse_rounds(s: &str) -> std::result::Result<usize, String> {
@@ -75,18 +80,20 @@ pub fn run(a: RaysArgs) -> Result<()> {
         || format!("--size {}", a.size),
         crate::bounded::bytes(a.size as u64 * a.size as u64, 256),
     )?;
-    let mut sets = rays::generate(&scene, a.size, a.seed);
+    let mut sets = rays::generate_packed(&scene, a.size, a.seed, a.packets);
     if !a.class.is_empty() {
         sets.retain(|s| a.class.iter().any(|c| c == s.class));
     }
     let subjects = rays::subjects(&scene, &a.backend, &isas)?;
-    let rows = pool.install(|| rays::measure(&name, &sets, &subjects, a.rounds, threads));
+    let rows =
+        pool.install(|| rays::measure(&name, &sets, &subjects, a.rounds, threads, a.packets));
     crate::output::write_csv(&path, &rows)?;
     let report = rays::RaysReport {
         scene: name,
         threads,
         size: a.size,
         rounds: a.rounds,
+        packing: a.packets,
         rows,
         csv: path,
     };

@@ -2,7 +2,7 @@
 //! ISA of the packet backend), interleaved round by round so machine noise hits all alike.
 
 use super::raysets;
-pub use super::raysets::{Query, RaySet};
+pub use super::raysets::{Packing, Query, RaySet};
 use crate::error::{Error, Result};
 use crate::prepare::PreparedScene;
 use crate::simd::Isa;
@@ -23,6 +23,16 @@ pub const BACKENDS: &[&str] = backends::AVAILABLE;
 /// The ray sets of `dibench rays`: [`raysets::generate`] for a `size`² image.
 pub fn generate(scene: &PreparedScene, size: u32, seed: u64) -> Vec<RaySet> {
     raysets::generate(scene, size, size, seed)
+}
+
+/// [`generate`] with the camera rays packed as `packing` says ([`raysets::generate_packed`]).
+pub fn generate_packed(
+    scene: &PreparedScene,
+    size: u32,
+    seed: u64,
+    packing: Packing,
+) -> Vec<RaySet> {
+    raysets::generate_packed(scene, size, size, seed, packing)
 }
 
 /// A backend under test: the obvhs baseline or the packet tracer at one ISA.
@@ -191,6 +201,7 @@ pub struct RaysReport {
     pub threads: usize,
     pub size: u32,
     pub rounds: usize,
+    pub packing: Packing,
     pub rows: Vec<RaysRow>,
     pub csv: PathBuf,
 }
@@ -202,8 +213,16 @@ impl std::fmt::Display for RaysReport {
         let rows = &self.rows;
         writeln!(
             f,
-            "scene {} · {} threads · {}x{} rays per class · best of {} rounds",
-            self.scene, self.threads, self.size, self.size, self.rounds
+            "scene {} · {} threads · {}x{} rays per class, packets of {} · best of {} rounds",
+            self.scene,
+            self.threads,
+            self.size,
+            self.size,
+            match self.packing {
+                Packing::Tile => "4x4 pixels",
+                Packing::Pixel => "one pixel's 16 samples",
+            },
+            self.rounds
         )?;
         writeln!(
             f,
@@ -271,6 +290,8 @@ pub struct RaysRow {
     pub backend: String,
     pub isa: String,
     pub ray_class: String,
+    /// What a packet's camera rays are: `tile` or `pixel` ([`Packing`]).
+    pub packets: &'static str,
     pub rays: u64,
     pub threads: usize,
     pub rounds: usize,
@@ -302,6 +323,7 @@ pub fn measure(
     subjects: &[Subject],
     rounds: usize,
     threads: usize,
+    packing: Packing,
 ) -> Vec<RaysRow> {
     let mut best = vec![vec![f64::INFINITY; subjects.len()]; sets.len()];
     for round in 0..rounds {
@@ -336,6 +358,7 @@ pub fn measure(
                 backend: backend.into(),
                 isa: isa.into(),
                 ray_class: set.class.into(),
+                packets: packing.name(),
                 rays,
                 threads,
                 rounds,

@@ -1,7 +1,8 @@
 //! The one generator of fixed, seeded ray sets drawn from a scene, for the throughput harness
 //! (`dibench rays`, the criterion benches) and the backend cross-check: camera rays through
-//! pixel centres in 4×4 tiles, and from each surface point a primary ray hits (found with the
-//! scene's own tracer, offset off the surface) a shadow ray to a light sample, a shadow ray
+//! pixel centres in 4×4 tiles (or, [`Packing::Pixel`], 16 jittered samples of one pixel per
+//! packet, as a render packs them), and from each surface point a primary ray hits (found with
+//! the scene's own tracer, offset off the surface) a shadow ray to a light sample, a shadow ray
 //! towards a fixed distant direction, and a uniformly random direction into the hemisphere
 //! facing the camera. Secondary rays stay in their primary's packet lane, as the renderer
 //! groups them; a lane without a ray of that class is inactive.
@@ -21,7 +22,28 @@ pub enum Query {
     Occluded,
 }
 
-/// One ray class as 16-ray packets (4×4 pixel tiles) with their active masks.
+/// What a packet's 16 camera rays are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Packing {
+    /// The centres of a 4×4 tile of pixels.
+    Tile,
+    /// 16 jittered samples of one pixel, as a render's passes in groups trace them
+    /// (docs/tracer.md, stop 42): their hit points lie within one pixel's footprint, so the
+    /// secondary rays of a packet share their origins but for that spread. The image is a
+    /// quarter as wide and high, so a set holds as many rays as with tiles.
+    Pixel,
+}
+
+impl Packing {
+    pub fn name(self) -> &'static str {
+        match self {
+            Packing::Tile => "tile",
+            Packing::Pixel => "pixel",
+        }
+    }
+}
+
+/// One ray class as 16-ray packets (see [`Packing`]) with their active masks.
 pub struct RaySet {
     pub class: &'static str,
     /// The class's natural query: occlusion for shadow rays, closest hit otherwise.
@@ -81,10 +103,25 @@ fn u01(key: u64) -> f32 {
     (mix64(key) >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 
-/// The four classes of [`CLASSES`] for a `width`×`height` image of the scene's camera.
+/// The four classes of [`CLASSES`] for a `width`×`height` image of the scene's camera, in
+/// 4×4 tiles.
 pub fn generate(scene: &PreparedScene, width: u32, height: u32, seed: u64) -> Vec<RaySet> {
+    generate_packed(scene, width, height, seed, Packing::Tile)
+}
+
+/// [`generate`] with the camera rays packed as `packing` says: `width`×`height` rays per
+/// class either way (with [`Packing::Pixel`], the samples of a (width/4)×(height/4) image,
+/// sides rounded up).
+pub fn generate_packed(
+    scene: &PreparedScene,
+    width: u32,
+    height: u32,
+    seed: u64,
+    packing: Packing,
+) -> Vec<RaySet> {
     let cam = &scene.scene.camera;
     let layout = TileLayout::new(width, height);
+    let (pw, ph) = (width.div_ceil(4), height.div_ceil(4));
     let distant = Vec3::new(0.35, 1.0, 0.25).normalize();
     let mut sets: Vec<RaySet> = CLASSES
         .into_iter()
@@ -97,12 +134,27 @@ pub fn generate(scene: &PreparedScene, width: u32, height: u32, seed: u64) -> Ve
         })
         .collect();
     let mut hits = HitPacket::default();
-    for tile in 0..layout.tile_count() {
+    let packets = match packing {
+        Packing::Tile => layout.tile_count(),
+        Packing::Pixel => (pw * ph) as usize,
+    };
+    for tile in 0..packets {
         let mut p = [RayPacket::default(); 4];
         let mut m = [0 as LaneMask; 4];
         for lane in 0..LANES {
-            if let Some((x, y)) = layout.lane_pixel(tile, lane) {
-                p[0].set(lane, &camera_ray(cam, width, height, x, y, [0.5, 0.5]));
+            let ray = match packing {
+                Packing::Tile => layout
+                    .lane_pixel(tile, lane)
+                    .map(|(x, y)| camera_ray(cam, width, height, x, y, [0.5, 0.5])),
+                Packing::Pixel => {
+                    let (x, y) = (tile as u32 % pw, tile as u32 / pw);
+                    let key = seed ^ 0x6a09_e667 ^ ((tile as u64) << 4 | lane as u64) << 8;
+                    let u = [u01(key), u01(key.wrapping_add(1))];
+                    Some(camera_ray(cam, pw, ph, x, y, u))
+                }
+            };
+            if let Some(ray) = ray {
+                p[0].set(lane, &ray);
                 m[0] |= 1 << lane;
             }
         }
