@@ -111,6 +111,15 @@ impl SceneView<'_> {
         }
     }
 
+    /// Starts the reads [`Self::add_env_radiance`] of the same directions will make (see
+    /// [`crate::env::texels::ImportanceMap::prefetch_lookups`]); nothing without an
+    /// environment.
+    pub fn prefetch_env(&self, isa: Isa, dirs: &Soa3, mask: u32) {
+        if let Some(env) = self.lights.environment() {
+            env.map(self.env).prefetch_lookups(isa, dirs, mask);
+        }
+    }
+
     /// Radiance an emitter primitive sends back along a ray that hit it.
     pub fn emitted(&self, surface: &SurfaceHit, ray_dir: Vec3) -> Vec3 {
         match surface.emitter {

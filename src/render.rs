@@ -551,15 +551,18 @@ impl<'a> Renderer<'a> {
         }
         if emit_mask != 0 {
             let emit = &probes.emission;
+            let dirs = Soa3 {
+                x: emit.dx,
+                y: emit.dy,
+                z: emit.dz,
+            };
+            // The environment's records of these directions, on their way while the rays
+            // are traced (those that escape read them).
+            self.view.prefetch_env(self.isa, &dirs, emit_mask as u32);
             let (found, escaped) = self.trace_emission(emit, emit_mask, ehits);
             let mut env = [Vec3::ZERO; LANES];
             let mut env_weight = [0.0f32; LANES];
             if escaped != 0 {
-                let dirs = Soa3 {
-                    x: emit.dx,
-                    y: emit.dy,
-                    z: emit.dz,
-                };
                 self.view
                     .add_env_radiance(self.isa, &dirs, escaped, &mut env);
                 env_weight = self

@@ -334,22 +334,29 @@ impl ImportanceMap {
             }
             return;
         }
-        struct Index<'a>(&'a TexelMap, &'a Soa3);
-        impl Kernel for Index<'_> {
-            type Out = [usize; WIDTH];
-            #[inline(always)]
-            fn run<L: Lanes>(self) -> [usize; WIDTH] {
-                let w = V3::<L::V>::load(self.1);
-                let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
-                self.0.index_lanes::<L::V, WIDTH>(u, v)
-            }
-        }
-        let k = simd::run(isa, Index(t, w));
+        let k = simd::run(isa, LatLongIndex(t, w));
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0 {
                 let [r, g, b, _] = *self.record(k[lane]);
                 *o += Vec3::new(r, g, b);
             }
+        }
+    }
+
+    /// Starts the reads of the records [`Self::add_lookups`] and [`Self::pdf_lanes`] will read
+    /// for the directions `w` of lanes `mask` (lat/long maps; the others read texels lane by
+    /// lane): called before the rays are traced, so the reads land meanwhile (2 MB of records,
+    /// read at random by escaped rays).
+    pub fn prefetch_lookups(&self, isa: Isa, w: &Soa3, mask: u32) {
+        if self.texels.repr != Repr::LatLong || mask == 0 {
+            return;
+        }
+        let k = simd::run(isa, LatLongIndex(&self.texels, w));
+        let mut rest = mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            crate::simd::prefetch(self.record(k[lane]));
         }
     }
 
@@ -401,6 +408,19 @@ impl ImportanceMap {
             }
         }
         simd::run(isa, Pdf(self, w, mask))
+    }
+}
+
+/// The lat/long texel of each lane's direction.
+struct LatLongIndex<'a>(&'a TexelMap, &'a Soa3);
+
+impl Kernel for LatLongIndex<'_> {
+    type Out = [usize; WIDTH];
+    #[inline(always)]
+    fn run<L: Lanes>(self) -> [usize; WIDTH] {
+        let w = V3::<L::V>::load(self.1);
+        let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
+        self.0.index_lanes::<L::V, WIDTH>(u, v)
     }
 }
 
