@@ -18,6 +18,7 @@ if [[ ${#CASES[@]} -eq 0 ]]; then
     env_venice_bunny:mis-env-latlong-hier:128 glossy:light:256 many_mesh:light:16)
 fi
 cd "$(dirname "$0")/.."
+source scripts/compare-rows.sh
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 for r in $(seq 1 "$ROUNDS"); do
@@ -26,13 +27,8 @@ for r in $(seq 1 "$ROUNDS"); do
     if (( r % 2 )); then order=(before after); else order=(after before); fi
     for which in "${order[@]}"; do
       bin=$A; [[ $which == after ]] && bin=$B
-      out=$(mktemp -d)
-      "$bin" compare "$scene" --strategies "$strat" --threads 1 --spp "$spp" --reference-spp 16 \
-        --out "$out" > /dev/null
-      csv=$(find "$out/$scene" -path '*/reference' -prune -o -name results.csv -print | head -1)
-      t=$(awk -F, -v s="$strat" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "time_s") c = i }
-        NR > 1 && $2 == s { t = $c } END { print t }' "$csv")
-      rm -rf "$out"
+      t=$(compare_rows "$bin" "$scene" --strategies "$strat" --threads 1 --spp "$spp" \
+        --reference-spp 16 | awk -v s="$strat" '$1 == s { print $3 }')
       echo "$scene $strat $spp round $r $which $t" | tee -a "$LOG"
     done
   done

@@ -15,6 +15,7 @@ set -euo pipefail
 BIN=$(realpath "$1"); ROUNDS=${2:-2}; TIME=${3:-2}
 shift $(( $# < 3 ? $# : 3 ))
 cd "$(dirname "$0")/.."
+source scripts/compare-rows.sh
 SCENES=("$@")
 if [[ ${#SCENES[@]} -eq 0 ]]; then
   for s in scenes/*.toml; do SCENES+=("$(basename "$s" .toml)"); done
@@ -31,18 +32,10 @@ for r in $(seq 1 "$ROUNDS"); do
     fi
     if (( r % 2 )); then order=(packet embree); else order=(embree packet); fi
     for backend in "${order[@]}"; do
-      out=$(mktemp -d)
-      "$BIN" compare "$scene" --strategies "$strats" --threads 1 --time "$TIME" \
-        --reference-spp 16 --backend "$backend" --out "$out" > /dev/null 2> "$out.err" \
-        || { cat "$out.err" >&2; exit 1; }
-      rm -f "$out.err"
-      csv=$(find "$out/$scene" -path '*/reference' -prune -o -name results.csv -print | head -1)
-      awk -F, -v sc="$scene" -v b="$backend" -v r="$r" '
-        NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "time_s") t = i; if ($i == "spp") s = i } }
-        NR > 1 { rate[$2] = $s / $t }
-        END { for (k in rate) printf "%s %s round %s %s %.1f\n", sc, k, r, b, rate[k] }' \
-        "$csv" | tee -a "$LOG"
-      rm -rf "$out"
+      rows=$(compare_rows "$BIN" "$scene" --strategies "$strats" --threads 1 --time "$TIME" \
+        --reference-spp 16 --backend "$backend")
+      awk -v sc="$scene" -v b="$backend" -v r="$r" \
+        '{ printf "%s %s round %s %s %.1f\n", sc, $1, r, b, $2 / $3 }' <<< "$rows" | tee -a "$LOG"
     done
   done
 done

@@ -13,6 +13,7 @@ shift $(( $# < 2 ? $# : 2 ))
 CASES=("$@")
 [[ ${#CASES[@]} -gt 0 ]] || CASES=(cornell:light:2048 cornell:mis-power:1024)
 cd "$(dirname "$0")/.."
+source scripts/compare-rows.sh
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 for r in $(seq 1 "$ROUNDS"); do
@@ -20,14 +21,8 @@ for r in $(seq 1 "$ROUNDS"); do
     IFS=: read -r scene strat spp <<< "$c"
     if (( r % 2 )); then order=(1 2); else order=(2 1); fi
     for t in "${order[@]}"; do
-      out=$(mktemp -d)
-      "$BIN" compare "$scene" --strategies "$strat" --threads "$t" --spp "$spp" \
-        --reference-spp 16 --out "$out" > /dev/null 2> "$out.err" \
-        || { cat "$out.err" >&2; exit 1; }
-      csv=$(find "$out/$scene" -path '*/reference' -prune -o -name results.csv -print | head -1)
-      s=$(awk -F, -v s="$strat" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "time_s") c = i }
-        NR > 1 && $2 == s { t = $c } END { print t }' "$csv")
-      rm -rf "$out" "$out.err"
+      s=$(compare_rows "$BIN" "$scene" --strategies "$strat" --threads "$t" --spp "$spp" \
+        --reference-spp 16 | awk -v s="$strat" '$1 == s { print $3 }')
       echo "$scene $strat $spp round $r threads $t $s" | tee -a "$LOG"
     done
   done

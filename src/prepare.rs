@@ -4,6 +4,7 @@
 //! A strategy sees both through a [`SceneView`], never the tracer.
 
 use crate::bsdf::Bsdf;
+use crate::env::texels::PrefetchedTexels;
 use crate::env::{Environment, Repr};
 use crate::geometry::sphere::Sphere;
 use crate::geometry::triangle::Triangle;
@@ -104,20 +105,29 @@ impl SceneView<'_> {
     }
 
     /// [`Self::env_radiance`] of the directions `dirs` of lanes `mask`, added to `out` (over
-    /// lanes where the representation has a kernel, with the same bits).
-    pub fn add_env_radiance(&self, isa: Isa, dirs: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
+    /// lanes where the representation has a kernel, with the same bits). `prefetched`: what
+    /// [`Self::prefetch_env`] returned for these directions.
+    pub fn add_env_radiance(
+        &self,
+        isa: Isa,
+        dirs: &Soa3,
+        prefetched: Option<&PrefetchedTexels>,
+        mask: u32,
+        out: &mut [Vec3; WIDTH],
+    ) {
         if let Some(env) = self.lights.environment() {
-            env.map(self.env).add_lookups(isa, dirs, mask, out);
+            env.map(self.env)
+                .add_lookups(isa, dirs, prefetched, mask, out);
         }
     }
 
-    /// Starts the reads [`Self::add_env_radiance`] of the same directions will make (see
-    /// [`crate::env::texels::ImportanceMap::prefetch_lookups`]); nothing without an
-    /// environment.
-    pub fn prefetch_env(&self, isa: Isa, dirs: &Soa3, mask: u32) {
-        if let Some(env) = self.lights.environment() {
-            env.map(self.env).prefetch_lookups(isa, dirs, mask);
-        }
+    /// Starts the reads [`Self::add_env_radiance`] of the same directions will make, and
+    /// returns their texels for it (see
+    /// [`crate::env::texels::ImportanceMap::prefetch_lookups`]); None without an environment.
+    pub fn prefetch_env(&self, isa: Isa, dirs: &Soa3, mask: u32) -> Option<PrefetchedTexels> {
+        self.lights
+            .environment()
+            .and_then(|env| env.map(self.env).prefetch_lookups(isa, dirs, mask))
     }
 
     /// Radiance an emitter primitive sends back along a ray that hit it.

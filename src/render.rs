@@ -429,7 +429,7 @@ impl<'a> Renderer<'a> {
                 z: cam.dz,
             };
             self.view
-                .add_env_radiance(self.isa, &dirs, escaped, &mut out.radiance);
+                .add_env_radiance(self.isa, &dirs, None, escaped, &mut out.radiance);
         }
         if hit_mask == 0 {
             return;
@@ -557,14 +557,14 @@ impl<'a> Renderer<'a> {
                 z: emit.dz,
             };
             // The environment's records of these directions, on their way while the rays
-            // are traced (those that escape read them).
-            self.view.prefetch_env(self.isa, &dirs, emit_mask as u32);
+            // are traced (those that escape read them, from these texels).
+            let texels = self.view.prefetch_env(self.isa, &dirs, emit_mask as u32);
             let (found, escaped) = self.trace_emission(emit, emit_mask, ehits);
             let mut env = [Vec3::ZERO; LANES];
             let mut env_weight = [0.0f32; LANES];
             if escaped != 0 {
                 self.view
-                    .add_env_radiance(self.isa, &dirs, escaped, &mut env);
+                    .add_env_radiance(self.isa, &dirs, texels.as_ref(), escaped, &mut env);
                 env_weight = self
                     .estimator()
                     .env_weight_packet(&*packet, probes, &dirs, escaped);

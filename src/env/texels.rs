@@ -324,7 +324,16 @@ impl ImportanceMap {
     /// for lat/long maps (bit for bit), lane by lane for the others. Over lanes the radiance is
     /// read from the records, so a pdf of the same direction ([`Self::pdf_lanes`], the MIS
     /// weight of an escaped BSDF sample) finds its density in the line already read.
-    pub fn add_lookups(&self, isa: Isa, w: &Soa3, mask: u32, out: &mut [Vec3; WIDTH]) {
+    /// `prefetched`: these directions' texels from [`Self::prefetch_lookups`], not worked out
+    /// again.
+    pub fn add_lookups(
+        &self,
+        isa: Isa,
+        w: &Soa3,
+        prefetched: Option<&PrefetchedTexels>,
+        mask: u32,
+        out: &mut [Vec3; WIDTH],
+    ) {
         let t = &self.texels;
         if t.repr != Repr::LatLong {
             for (lane, o) in out.iter_mut().enumerate() {
@@ -334,7 +343,10 @@ impl ImportanceMap {
             }
             return;
         }
-        let k = simd::run(isa, LatLongIndex(t, w));
+        let k = match prefetched {
+            Some(p) => p.0,
+            None => simd::run(isa, LatLongIndex(t, w)),
+        };
         for (lane, o) in out.iter_mut().enumerate() {
             if mask >> lane & 1 != 0 {
                 let [r, g, b, _] = *self.record(k[lane]);
@@ -344,12 +356,12 @@ impl ImportanceMap {
     }
 
     /// Starts the reads of the records [`Self::add_lookups`] and [`Self::pdf_lanes`] will read
-    /// for the directions `w` of lanes `mask` (lat/long maps; the others read texels lane by
-    /// lane): called before the rays are traced, so the reads land meanwhile (2 MB of records,
-    /// read at random by escaped rays).
-    pub fn prefetch_lookups(&self, isa: Isa, w: &Soa3, mask: u32) {
-        if self.texels.repr != Repr::LatLong || mask == 0 {
-            return;
+    /// for the directions `w` of lanes `mask`, and returns their texels for `add_lookups`
+    /// (lat/long maps; the others read texels lane by lane: None). Called before the rays are
+    /// traced, so the reads land meanwhile (2 MB of records, read at random by escaped rays).
+    pub fn prefetch_lookups(&self, isa: Isa, w: &Soa3, mask: u32) -> Option<PrefetchedTexels> {
+        if self.texels.repr != Repr::LatLong {
+            return None;
         }
         let k = simd::run(isa, LatLongIndex(&self.texels, w));
         let mut rest = mask;
@@ -358,6 +370,7 @@ impl ImportanceMap {
             rest &= rest - 1;
             crate::simd::prefetch(self.record(k[lane]));
         }
+        Some(PrefetchedTexels(k))
     }
 
     /// Solid-angle pdf of direction `w`: 0 for a black map, in black texels and at J = 0.
@@ -410,6 +423,10 @@ impl ImportanceMap {
         simd::run(isa, Pdf(self, w, mask))
     }
 }
+
+/// The lat/long texels of a packet's directions, their records on their way
+/// ([`ImportanceMap::prefetch_lookups`]).
+pub struct PrefetchedTexels([usize; WIDTH]);
 
 /// The lat/long texel of each lane's direction.
 struct LatLongIndex<'a>(&'a TexelMap, &'a Soa3);
@@ -574,20 +591,26 @@ mod tests {
             for round in 0..300 {
                 let (w, mask) = directions(&mut rng, round);
                 for isa in Isa::available() {
-                    let mut out = [Vec3::splat(0.25); WIDTH];
-                    m.add_lookups(isa, &w, mask, &mut out);
-                    for (lane, o) in out.iter().enumerate() {
-                        let want = if mask >> lane & 1 != 0 {
-                            Vec3::splat(0.25) + m.texels.lookup(w.get(lane))
-                        } else {
-                            Vec3::splat(0.25)
-                        };
-                        assert_eq!(
-                            o.to_array().map(f32::to_bits),
-                            want.to_array().map(f32::to_bits),
-                            "{isa:?} {repr:?} lane {lane} w {:?}",
-                            w.get(lane)
-                        );
+                    // Worked out here, and from the texels the prefetch found (lat/long).
+                    let prefetched = m.prefetch_lookups(isa, &w, mask);
+                    assert_eq!(prefetched.is_some(), repr == Repr::LatLong, "{repr:?}");
+                    for given in [None, prefetched.as_ref()] {
+                        let mut out = [Vec3::splat(0.25); WIDTH];
+                        m.add_lookups(isa, &w, given, mask, &mut out);
+                        for (lane, o) in out.iter().enumerate() {
+                            let want = if mask >> lane & 1 != 0 {
+                                Vec3::splat(0.25) + m.texels.lookup(w.get(lane))
+                            } else {
+                                Vec3::splat(0.25)
+                            };
+                            assert_eq!(
+                                o.to_array().map(f32::to_bits),
+                                want.to_array().map(f32::to_bits),
+                                "{isa:?} {repr:?} lane {lane} prefetched {} w {:?}",
+                                given.is_some(),
+                                w.get(lane)
+                            );
+                        }
                     }
                 }
             }

@@ -291,7 +291,7 @@ pub struct RaysRow {
     pub isa: String,
     pub ray_class: String,
     /// What a packet's camera rays are: `tile` or `pixel` ([`Packing`]).
-    pub packets: &'static str,
+    pub packets: Packing,
     pub rays: u64,
     pub threads: usize,
     pub rounds: usize,
@@ -358,7 +358,7 @@ pub fn measure(
                 backend: backend.into(),
                 isa: isa.into(),
                 ray_class: set.class.into(),
-                packets: packing.name(),
+                packets: packing,
                 rays,
                 threads,
                 rounds,

@@ -23,7 +23,8 @@ pub enum Query {
 }
 
 /// What a packet's 16 camera rays are.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Packing {
     /// The centres of a 4×4 tile of pixels.
     Tile,
@@ -32,15 +33,6 @@ pub enum Packing {
     /// secondary rays of a packet share their origins but for that spread. The image is a
     /// quarter as wide and high, so a set holds as many rays as with tiles.
     Pixel,
-}
-
-impl Packing {
-    pub fn name(self) -> &'static str {
-        match self {
-            Packing::Tile => "tile",
-            Packing::Pixel => "pixel",
-        }
-    }
 }
 
 /// One ray class as 16-ray packets (see [`Packing`]) with their active masks.
