@@ -2,6 +2,7 @@
 //! the view and the microfacet normal. The outside medium is vacuum (index 1) on the viewer's
 //! side (docs/conventions.md).
 
+use crate::simd::{V3, Vector, WIDTH};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,6 +31,26 @@ impl Fresnel {
         }
     }
 
+    /// [`Self::eval`] over lanes, the same operations in the same order per lane.
+    #[inline(always)]
+    pub fn eval_lanes<V: Vector<WIDTH>>(&self, cos: V) -> V3<V> {
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        // f32::clamp's two comparisons (a −0 stays −0, as there).
+        let c = V::select(cos.lt(zero), zero, cos);
+        let c = V::select(one.lt(c), one, c);
+        match *self {
+            Fresnel::One => V3::splat(Vec3::ONE),
+            Fresnel::Schlick { f0 } => {
+                V3::splat(f0) + V3::splat(Vec3::ONE - f0).scale(schlick_weight_lanes(c))
+            }
+            Fresnel::Conductor { eta, k } => V3 {
+                x: conductor_lanes(c, eta.x, k.x),
+                y: conductor_lanes(c, eta.y, k.y),
+                z: conductor_lanes(c, eta.z, k.z),
+            },
+        }
+    }
+
     /// F is 1 for every angle (no colour or angle dependence to estimate).
     pub fn is_one(&self) -> bool {
         match *self {
@@ -45,6 +66,14 @@ pub fn schlick_weight(c: f32) -> f32 {
     let m = 1.0 - c;
     let m2 = m * m;
     m2 * m2 * m
+}
+
+/// [`schlick_weight`] over lanes.
+#[inline(always)]
+pub fn schlick_weight_lanes<V: Vector<N>, const N: usize>(c: V) -> V {
+    let m = V::splat(1.0).sub(c);
+    let m2 = m.mul(m);
+    m2.mul(m2).mul(m)
 }
 
 /// ∫ over the hemisphere of Schlick's F(cos θ)·cos θ dω / π = F0 + (1 − F0)/21: the cosine-
@@ -119,6 +148,91 @@ pub fn conductor(c: f32, eta: f32, k: f32) -> f32 {
     let perp = cc.sub(n.mul(cos_t)).div(cc.add(n.mul(cos_t)));
     let parl = n.scale(c).sub(cos_t).div(n.scale(c).add(cos_t));
     0.5 * (perp.norm2() + parl.norm2())
+}
+
+/// [`C`] over lanes: the same operations in the same order, branches as selects.
+#[derive(Clone, Copy)]
+struct CLanes<V> {
+    re: V,
+    im: V,
+}
+
+impl<V: Vector<WIDTH>> CLanes<V> {
+    #[inline(always)]
+    fn new(re: V, im: V) -> Self {
+        CLanes { re, im }
+    }
+    #[inline(always)]
+    fn splat(c: C) -> Self {
+        CLanes::new(V::splat(c.re), V::splat(c.im))
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        CLanes::new(self.re.add(o.re), self.im.add(o.im))
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        CLanes::new(self.re.sub(o.re), self.im.sub(o.im))
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        CLanes::new(
+            self.re.mul(o.re).sub(self.im.mul(o.im)),
+            self.re.mul(o.im).add(self.im.mul(o.re)),
+        )
+    }
+    #[inline(always)]
+    fn scale(self, s: V) -> Self {
+        CLanes::new(self.re.mul(s), self.im.mul(s))
+    }
+    #[inline(always)]
+    fn norm2(self) -> V {
+        self.re.mul(self.re).add(self.im.mul(self.im))
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        let d = o.norm2();
+        CLanes::new(
+            self.re.mul(o.re).add(self.im.mul(o.im)).div(d),
+            self.im.mul(o.re).sub(self.re.mul(o.im)).div(d),
+        )
+    }
+    /// [`C::sqrt`]: lanes of modulus 0 give 0 (their t is replaced by 1 so that no lane
+    /// divides by zero); t > 0 elsewhere, so copysign is a negation where im's sign bit is set.
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let (zero, half) = (V::splat(0.0), V::splat(0.5));
+        let m = self.norm2().sqrt();
+        let null = m.eq(zero);
+        let t = half.mul(m.add(self.re.abs())).sqrt();
+        let t = V::select(null, V::splat(1.0), t);
+        let right = !self.re.lt(zero);
+        let re = V::select(right, t, half.mul(self.im.abs()).div(t));
+        let im = V::select(
+            right,
+            half.mul(self.im).div(t),
+            V::select(self.im.sign(), t.neg(), t),
+        );
+        CLanes::new(V::select(null, zero, re), V::select(null, zero, im))
+    }
+}
+
+/// [`conductor`] over lanes of c, for one channel's η and κ.
+#[inline(always)]
+fn conductor_lanes<V: Vector<WIDTH>>(c: V, eta: f32, k: f32) -> V {
+    if eta == 1.0 && k == 0.0 {
+        return V::splat(0.0);
+    }
+    let zero = V::splat(0.0);
+    let n = CLanes::<V>::splat(C::new(eta, k));
+    let sin2 = CLanes::new(V::splat(1.0).sub(c.mul(c)).max(zero), zero);
+    let cos_t = CLanes::splat(C::new(1.0, 0.0))
+        .sub(sin2.div(n.mul(n)))
+        .sqrt();
+    let cc = CLanes::new(c, zero);
+    let perp = cc.sub(n.mul(cos_t)).div(cc.add(n.mul(cos_t)));
+    let parl = n.scale(c).sub(cos_t).div(n.scale(c).add(cos_t));
+    V::splat(0.5).mul(perp.norm2().add(parl.norm2()))
 }
 
 /// Named conductors: complex index (η, κ) per channel at 650, 550 and 450 nm (R, G, B),

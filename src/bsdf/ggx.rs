@@ -6,10 +6,11 @@
 
 use super::fresnel::{Fresnel, conductor_preset};
 use super::material::{MaterialType, Params};
-use super::{Bsdf, Lobe, MicrofacetSampler};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler};
 use crate::error::Result;
 pub use crate::sampling::microfacet::Ggx;
 use crate::sampling::microfacet::half_vector;
+use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,6 +38,10 @@ impl Lobe for GgxLobe {
             return Vec3::ZERO;
         }
         self.ks * self.fresnel.eval(wo.dot(h)) * self.dist.d_g2_over_cosines(wo, wi, h)
+    }
+
+    fn add_eval_lanes(&self, isa: Isa, wo: &Soa3, wi: &Soa3, mask: u32, acc: &mut Soa3) {
+        super::add_eval_lanes(self, isa, wo, wi, mask, acc);
     }
 
     fn sample(&self, wo: Vec3, u: [f32; 2], sampler: MicrofacetSampler) -> Vec3 {
@@ -75,6 +80,26 @@ impl Lobe for GgxLobe {
 
     fn half_vector_spread(&self) -> [f32; 2] {
         [self.dist.ax, self.dist.ay]
+    }
+}
+
+impl EvalLanes for GgxLobe {
+    /// [`Lobe::eval`]: the half vector, then [`Lobe::eval_with_half_vector`].
+    #[inline(always)]
+    fn eval_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>) -> V3<V> {
+        let zero = V::splat(0.0);
+        let above = !wo.z.le(zero) & !wi.z.le(zero);
+        // Lanes below the surface (f = 0) go on with the normal for both directions.
+        let up = V3::splat(Vec3::Z);
+        let (wo, wi) = (V3::select(above, wo, up), V3::select(above, wi, up));
+        // `half_vector`: none where |wo + wi|² is 0 (f = 0 there too; such lanes divide by 1).
+        let s = wo + wi;
+        let len2 = s.dot(s);
+        let has_h = zero.lt(len2);
+        let h = s / V::select(has_h, len2, V::splat(1.0)).sqrt();
+        let f = (V3::splat(self.ks) * self.fresnel.eval_lanes(wo.dot(h)))
+            .scale(self.dist.d_g2_over_cosines_lanes(wo, wi, h));
+        V3::select(above & has_h, f, V3::splat(Vec3::ZERO))
     }
 }
 

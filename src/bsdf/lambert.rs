@@ -2,10 +2,10 @@
 //! material type.
 
 use super::material::{MaterialType, Params};
-use super::{Bsdf, Lobe, MicrofacetSampler};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler};
 use crate::error::Result;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
-use crate::simd::{V3, Vector, WIDTH};
+use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 
@@ -22,6 +22,10 @@ impl Lobe for Lambert {
         self.kd * FRAC_1_PI
     }
 
+    fn add_eval_lanes(&self, isa: Isa, wo: &Soa3, wi: &Soa3, mask: u32, acc: &mut Soa3) {
+        super::add_eval_lanes(self, isa, wo, wi, mask, acc);
+    }
+
     fn sample(&self, _wo: Vec3, u: [f32; 2], _: MicrofacetSampler) -> Vec3 {
         sample_cosine_hemisphere(u)
     }
@@ -36,6 +40,14 @@ impl Lobe for Lambert {
 
     fn is_cosine_sampled(&self) -> bool {
         true
+    }
+}
+
+impl EvalLanes for Lambert {
+    #[inline(always)]
+    fn eval_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, wi: V3<V>) -> V3<V> {
+        let f = V3::splat(self.kd).scale(V::splat(FRAC_1_PI));
+        V3::select(!wi.z.le(V::splat(0.0)), f, V3::splat(Vec3::ZERO))
     }
 }
 

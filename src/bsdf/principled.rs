@@ -9,12 +9,13 @@
 //! by-albedo selection policy; by coefficient, the GGX lobe weighs its F0 and the diffuse lobe
 //! its (1 − metallic)·base.
 
-use super::fresnel::{Fresnel, schlick_hemispherical_mean, schlick_weight};
+use super::fresnel::{Fresnel, schlick_hemispherical_mean, schlick_weight, schlick_weight_lanes};
 use super::ggx::{GgxLobe, parse_distribution};
 use super::material::{MaterialType, Params};
-use super::{Bsdf, Lobe, MicrofacetSampler};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler};
 use crate::error::Result;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
 use std::sync::Arc;
@@ -35,12 +36,39 @@ impl FresnelDiffuse {
     }
 }
 
+impl FresnelDiffuse {
+    /// [`Self::transmitted`] over lanes (the clamp's two comparisons as there).
+    #[inline(always)]
+    fn transmitted_lanes<V: Vector<WIDTH>>(&self, cos: V) -> V {
+        let (zero, one) = (V::splat(0.0), V::splat(1.0));
+        let c = V::select(cos.lt(zero), zero, cos);
+        let c = V::select(one.lt(c), one, c);
+        V::splat(1.0 - self.f0).mul(one.sub(schlick_weight_lanes(c)))
+    }
+}
+
+impl EvalLanes for FresnelDiffuse {
+    #[inline(always)]
+    fn eval_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>) -> V3<V> {
+        let zero = V::splat(0.0);
+        let above = !wi.z.le(zero) & !wo.z.le(zero);
+        let s = V::splat(FRAC_1_PI)
+            .mul(self.transmitted_lanes(wo.z))
+            .mul(self.transmitted_lanes(wi.z));
+        V3::select(above, V3::splat(self.kd).scale(s), V3::splat(Vec3::ZERO))
+    }
+}
+
 impl Lobe for FresnelDiffuse {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return Vec3::ZERO;
         }
         self.kd * (FRAC_1_PI * self.transmitted(wo.z) * self.transmitted(wi.z))
+    }
+
+    fn add_eval_lanes(&self, isa: Isa, wo: &Soa3, wi: &Soa3, mask: u32, acc: &mut Soa3) {
+        super::add_eval_lanes(self, isa, wo, wi, mask, acc);
     }
 
     fn sample(&self, _wo: Vec3, u: [f32; 2], _: MicrofacetSampler) -> Vec3 {

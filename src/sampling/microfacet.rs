@@ -10,6 +10,7 @@
 //! stretched length t(ω) = |(αx ωx, αy ωy, ωz)| so that nothing divides by cos θ (Heitz 2014,
 //! "Understanding the masking-shadowing function", eqs. 72 and 99 rearranged).
 
+use crate::simd::{V3, Vector, WIDTH};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -153,6 +154,38 @@ impl Ggx {
         let (zo, zi) = (wo.z.abs(), wi.z.abs());
         let denom = zo * self.stretched_len(wi) + zi * self.stretched_len(wo);
         0.5 * self.d(h) / denom
+    }
+
+    /// [`Self::d`] over lanes, the same operations in the same order (the constant
+    /// π·αx·αy rounded as the scalar product's first two steps round it).
+    #[inline(always)]
+    pub fn d_lanes<V: Vector<WIDTH>>(&self, h: V3<V>) -> V {
+        let zero = V::splat(0.0);
+        let (x, y) = (h.x.div(V::splat(self.ax)), h.y.div(V::splat(self.ay)));
+        let s = x.mul(x).add(y.mul(y)).add(h.z.mul(h.z));
+        let d = V::splat(1.0).div(V::splat(PI * self.ax * self.ay).mul(s).mul(s));
+        V::select(h.z.le(zero), zero, d)
+    }
+
+    /// [`Self::stretched_len`] over lanes.
+    #[inline(always)]
+    pub fn stretched_len_lanes<V: Vector<WIDTH>>(&self, w: V3<V>) -> V {
+        let s = V3 {
+            x: V::splat(self.ax).mul(w.x),
+            y: V::splat(self.ay).mul(w.y),
+            z: w.z,
+        };
+        s.dot(s).sqrt()
+    }
+
+    /// [`Self::d_g2_over_cosines`] over lanes.
+    #[inline(always)]
+    pub fn d_g2_over_cosines_lanes<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>, h: V3<V>) -> V {
+        let (zo, zi) = (wo.z.abs(), wi.z.abs());
+        let denom = zo
+            .mul(self.stretched_len_lanes(wi))
+            .add(zi.mul(self.stretched_len_lanes(wo)));
+        V::splat(0.5).mul(self.d_lanes(h)).div(denom)
     }
 
     /// The floor −b of the sampled cap's z in the stretched frame: b = k·ŵo.z with Eto &

@@ -208,8 +208,8 @@ fn cosine_query(packet: &ShadingPacket, u: [&[f32; WIDTH]; 2]) -> CosineQuery {
 /// material is cosine-sampled draw their directions over lanes ([`sample_cosine_lanes`]: the
 /// lobe drawn by u[2] does not change the direction), the others one by one. Diffuse lanes
 /// (a material of one built-in Lambert lobe) finish over lanes too, f = kd/π and pdf = cos/π
-/// with the scalar path's operations ([`DiffuseProbes`]); the other cosine-sampled ones
-/// evaluate f and the mixture pdf lane by lane.
+/// with the scalar path's operations ([`DiffuseProbes`]); the others evaluate f over lanes,
+/// once per material ([`crate::bsdf::Bsdf::eval_lanes`]), and the mixture pdf lane by lane.
 #[inline(always)]
 pub fn bsdf_emission_packet(
     isa: Isa,
@@ -219,8 +219,10 @@ pub fn bsdf_emission_packet(
     out: &mut ProbePacket,
 ) {
     let [u0, u1, u2] = u.take::<3>();
-    let (mut cosine, mut diffuse) = (0u32, 0u32);
+    let (mut cosine, mut diffuse, mut other) = (0u32, 0u32, 0u32);
     let mut kd = Soa3::default();
+    // The other lanes' directions, sampled lane by lane; f of all of them over lanes below.
+    let (mut wi, mut local) = (Soa3::default(), Soa3::default());
     let mut rest = packet.mask;
     while rest != 0 {
         let lane = rest.trailing_zeros() as usize;
@@ -234,26 +236,30 @@ pub fn bsdf_emission_packet(
         } else if bsdf.is_cosine_sampled() {
             cosine |= 1 << lane;
         } else if let Some(bsdf) = packet.local_bsdf(lane) {
-            let s = bsdf.sample([u0[lane], u1[lane], u2[lane]], sampling);
-            let e = emission_probe_lane(packet, lane, s.wi, s.f, s.pdf).emission;
-            out.set_emission(lane, e);
+            other |= 1 << lane;
+            let (w, l) = bsdf.sample_direction([u0[lane], u1[lane], u2[lane]], sampling);
+            wi.set(lane, w);
+            local.set(lane, l);
         }
+    }
+    if other != 0 {
+        // As `LocalBsdf::sample`: f and the pdf of the direction as rounded to world space.
+        let mut f = Soa3::default();
+        packet.each_material(other, |bsdf, lanes| {
+            bsdf.eval_lanes(isa, &packet.geo.wo_local, &local, lanes, &mut f);
+        });
+        probe_lanes(packet, other, &wi, &local, &f, sampling, out);
     }
     if cosine | diffuse == 0 {
         return;
     }
     let r = sample_cosine_lanes(isa, &cosine_query(packet, [u0, u1]));
-    let mut rest = cosine;
-    while rest != 0 {
-        let lane = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        let Some(bsdf) = packet.local_bsdf(lane) else {
-            continue;
-        };
-        let local = r.local.get(lane);
-        let (f, pdf) = (bsdf.eval_local(local), bsdf.pdf_local(local, sampling));
-        let e = emission_probe_lane(packet, lane, r.wi.get(lane), f, pdf).emission;
-        out.set_emission(lane, e);
+    if cosine != 0 {
+        let mut f = Soa3::default();
+        packet.each_material(cosine, |bsdf, lanes| {
+            bsdf.eval_lanes(isa, &packet.geo.wo_local, &r.local, lanes, &mut f);
+        });
+        probe_lanes(packet, cosine, &r.wi, &r.local, &f, sampling, out);
     }
     if diffuse != 0 {
         simd::run(
@@ -266,6 +272,32 @@ pub fn bsdf_emission_packet(
                 out,
             },
         );
+    }
+}
+
+/// The emission probes of the lanes of `mask` from their sampled directions (`wi` in the
+/// world, `local` in the shading frame) and f: each lane's mixture pdf, then
+/// [`emission_probe_lane`].
+#[inline(always)]
+fn probe_lanes(
+    packet: &ShadingPacket,
+    mask: u32,
+    wi: &Soa3,
+    local: &Soa3,
+    f: &Soa3,
+    sampling: BsdfSampling,
+    out: &mut ProbePacket,
+) {
+    let mut rest = mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        let Some(bsdf) = packet.local_bsdf(lane) else {
+            continue;
+        };
+        let pdf = bsdf.pdf_local(local.get(lane), sampling);
+        let e = emission_probe_lane(packet, lane, wi.get(lane), f.get(lane), pdf).emission;
+        out.set_emission(lane, e);
     }
 }
 

@@ -173,24 +173,31 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
 }
 
 /// Each shadow lane's unweighted value f·L·cos θ/pdf, handed to `each(lane, bsdf, local,
-/// value)` with the lane's material and the direction in its shading frame: only f is
-/// evaluated lane by lane, from the packet's rows (no point is built).
+/// value)` with the lane's material and the direction in its shading frame. f is evaluated
+/// over lanes, once for each material among the lanes ([`Bsdf::eval_lanes`]: a pixel's
+/// samples mostly share one), from the packet's rows (no point is built).
 #[inline(always)]
 fn shadow_values(
+    isa: Isa,
     packet: &ShadingPacket,
     r: &ShadowRays,
     ls: &LaneSamples,
-    mut valid: u32,
+    valid: u32,
     mut each: impl FnMut(usize, &LocalBsdf, Vec3, Vec3),
 ) {
-    while valid != 0 {
-        let lane = valid.trailing_zeros() as usize;
-        valid &= valid - 1;
+    let mut f = Soa3::default();
+    packet.each_material(valid, |bsdf, lanes| {
+        bsdf.eval_lanes(isa, &packet.geo.wo_local, &r.local, lanes, &mut f);
+    });
+    let mut rest = valid;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
         let bsdf = packet
             .local_bsdf(lane)
             .expect("a valid shadow lane has a point");
         let local = r.local.get(lane);
-        let value = bsdf.eval_local(local) * ls.radiance.get(lane) * r.factor[lane];
+        let value = f.get(lane) * ls.radiance.get(lane) * r.factor[lane];
         each(lane, &bsdf, local, value);
     }
 }
@@ -302,8 +309,9 @@ impl<'s> BoundLights<'s> {
 
     /// [`Self::probe`] for a packet of shading points, bit for bit: the lights are chosen lane
     /// by lane, each chosen light samples its lanes at once ([`Light::sample_lanes`]), and the
-    /// shadow segments, cosines and pdfs are computed over lanes; only f is evaluated lane by
-    /// lane. Lanes without a point are left as they are.
+    /// shadow segments, cosines and pdfs are computed over lanes, and f over lanes once per
+    /// material ([`crate::bsdf::Bsdf::eval_lanes`]). Lanes without a point are left as they
+    /// are.
     pub fn probe_packet(
         &self,
         packet: &ShadingPacket,
@@ -331,6 +339,7 @@ impl<'s> BoundLights<'s> {
         let mut records = [[0.0; LANES]; LANE_RECORD];
         let r = self.shadow_rays(packet, u, &mut ls, &mut records, &mut light);
         shadow_values(
+            self.isa,
             packet,
             &r,
             &ls,
@@ -354,7 +363,8 @@ impl<'s> BoundLights<'s> {
     /// [`LightWeight`] (1 for plain light sampling, the MIS weight for MIS: `value · w`, as the
     /// scalar path's `value *= w`). Diffuse lanes (a material of one built-in Lambert lobe)
     /// evaluate f = kd/π, the value and the weight over lanes, with the scalar operations in
-    /// their order ([`DiffuseValues`]); the others lane by lane.
+    /// their order ([`DiffuseValues`]); the others evaluate f over lanes once per material
+    /// and weigh lane by lane.
     #[inline(always)]
     pub fn probe_packet_rows<W: LightWeight>(
         &self,
@@ -400,6 +410,7 @@ impl<'s> BoundLights<'s> {
             delta |= (is_delta as u32) << lane;
         }
         shadow_values(
+            self.isa,
             packet,
             &r,
             ls,

@@ -215,6 +215,30 @@ impl<'a> ShadingPacket<'a> {
         }
     }
 
+    /// Calls `each(material, lanes)` once for each material among the lanes of `mask`, with
+    /// the lanes that hold it (a pixel's samples mostly share one).
+    #[inline(always)]
+    pub fn each_material(&self, mask: u32, mut each: impl FnMut(&'a Bsdf, u32)) {
+        let mut rest = mask & self.mask;
+        while rest != 0 {
+            let Some(bsdf) = self.bsdf[rest.trailing_zeros() as usize] else {
+                rest &= rest - 1;
+                continue;
+            };
+            let mut same = 0u32;
+            let mut m = rest;
+            while m != 0 {
+                let lane = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if self.bsdf[lane].is_some_and(|b| std::ptr::eq(b, bsdf)) {
+                    same |= 1 << lane;
+                }
+            }
+            each(bsdf, same);
+            rest &= !same;
+        }
+    }
+
     /// Lane `lane`'s material in its shading frame (what evaluating f needs, without the
     /// rest of the point).
     #[inline(always)]
