@@ -6,7 +6,7 @@
 
 use super::fresnel::{Fresnel, conductor_preset};
 use super::material::{MaterialType, Params};
-use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery};
 use crate::error::Result;
 pub use crate::sampling::microfacet::Ggx;
 use crate::sampling::microfacet::half_vector;
@@ -42,6 +42,10 @@ impl Lobe for GgxLobe {
 
     fn add_eval_lanes(&self, isa: Isa, wo: &Soa3, wi: &Soa3, mask: u32, acc: &mut Soa3) {
         super::add_eval_lanes(self, isa, wo, wi, mask, acc);
+    }
+
+    fn add_pdf_lanes(&self, isa: Isa, q: &PdfQuery, p: f32, acc: &mut [f32; WIDTH]) {
+        super::add_pdf_lanes(self, isa, q, p, acc);
     }
 
     fn sample(&self, wo: Vec3, u: [f32; 2], sampler: MicrofacetSampler) -> Vec3 {
@@ -89,18 +93,59 @@ impl EvalLanes for GgxLobe {
     fn eval_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>) -> V3<V> {
         let zero = V::splat(0.0);
         let above = !wo.z.le(zero) & !wi.z.le(zero);
-        // Lanes below the surface (f = 0) go on with the normal for both directions.
-        let up = V3::splat(Vec3::Z);
-        let (wo, wi) = (V3::select(above, wo, up), V3::select(above, wi, up));
-        // `half_vector`: none where |wo + wi|² is 0 (f = 0 there too; such lanes divide by 1).
-        let s = wo + wi;
-        let len2 = s.dot(s);
-        let has_h = zero.lt(len2);
-        let h = s / V::select(has_h, len2, V::splat(1.0)).sqrt();
+        let (ok, wo, wi, h) = half_vector_lanes(above, wo, wi);
         let f = (V3::splat(self.ks) * self.fresnel.eval_lanes(wo.dot(h)))
             .scale(self.dist.d_g2_over_cosines_lanes(wo, wi, h));
-        V3::select(above & has_h, f, V3::splat(Vec3::ZERO))
+        V3::select(ok, f, V3::splat(Vec3::ZERO))
     }
+
+    /// [`Lobe::pdf`]: [`MicrofacetSampler::pdf`] for wo.z > 0, the half vector taken on the
+    /// upper side; the bounded sampler's cap test stays lane by lane.
+    #[inline(always)]
+    fn pdf_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>, sampler: MicrofacetSampler) -> V {
+        let zero = V::splat(0.0);
+        let (ok, wo, _, h) = half_vector_lanes(!wo.z.le(zero), wo, wi);
+        let h = V3::select(h.z.lt(zero), -h, h);
+        let g = &self.dist;
+        let (pdf, valid) = match sampler {
+            MicrofacetSampler::Ndf => {
+                // ggx_ndf_pdf: d(h)·h.z/(4 |wo·h|), 0 where wo·h = 0.
+                let c = wo.dot(h).abs();
+                let nonzero = !c.eq(zero);
+                let c = V::select(nonzero, c, V::splat(1.0));
+                (g.d_lanes(h).mul(h.z).div(V::splat(4.0).mul(c)), nonzero)
+            }
+            _ => {
+                // ggx_cap_pdf with k = 1: 0.5·d(h)/(k·wo.z + t(wo)), 0 unless wo.z, h.z and
+                // wo·h are all positive.
+                let valid = !wo.z.le(zero) & !h.z.le(zero) & !wo.dot(h).le(zero);
+                let denom = V::splat(1.0).mul(wo.z).add(g.stretched_len_lanes(wo));
+                (V::splat(0.5).mul(g.d_lanes(h)).div(denom), valid)
+            }
+        };
+        V::select(ok & valid, pdf, zero)
+    }
+
+    fn pdf_over_lanes(&self, sampler: MicrofacetSampler) -> bool {
+        sampler != MicrofacetSampler::VndfBounded
+    }
+}
+
+/// `half_vector(wo, wi)` over lanes for the lanes of `take`: (the lanes of `take` that have
+/// one, wo, wi, h), the lanes without one (|wo + wi|² = 0) or outside `take` going on with the
+/// normal for both directions, so that every lane's arithmetic stays finite.
+#[inline(always)]
+fn half_vector_lanes<V: Vector<WIDTH>>(
+    take: u32,
+    wo: V3<V>,
+    wi: V3<V>,
+) -> (u32, V3<V>, V3<V>, V3<V>) {
+    let s = wo + wi;
+    let ok = take & V::splat(0.0).lt(s.dot(s));
+    let up = V3::splat(Vec3::Z);
+    let (wo, wi) = (V3::select(ok, wo, up), V3::select(ok, wi, up));
+    let s = wo + wi;
+    (ok, wo, wi, s / s.dot(s).sqrt())
 }
 
 /// The smallest α a scene may ask for: below it the lobe is narrower than the f32 direction

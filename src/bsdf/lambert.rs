@@ -2,7 +2,7 @@
 //! material type.
 
 use super::material::{MaterialType, Params};
-use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery};
 use crate::error::Result;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
@@ -24,6 +24,10 @@ impl Lobe for Lambert {
 
     fn add_eval_lanes(&self, isa: Isa, wo: &Soa3, wi: &Soa3, mask: u32, acc: &mut Soa3) {
         super::add_eval_lanes(self, isa, wo, wi, mask, acc);
+    }
+
+    fn add_pdf_lanes(&self, isa: Isa, q: &PdfQuery, p: f32, acc: &mut [f32; WIDTH]) {
+        super::add_pdf_lanes(self, isa, q, p, acc);
     }
 
     fn sample(&self, _wo: Vec3, u: [f32; 2], _: MicrofacetSampler) -> Vec3 {
@@ -48,6 +52,12 @@ impl EvalLanes for Lambert {
     fn eval_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, wi: V3<V>) -> V3<V> {
         let f = V3::splat(self.kd).scale(V::splat(FRAC_1_PI));
         V3::select(!wi.z.le(V::splat(0.0)), f, V3::splat(Vec3::ZERO))
+    }
+
+    /// `cosine_hemisphere_pdf(wi.z)`.
+    #[inline(always)]
+    fn pdf_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, wi: V3<V>, _: MicrofacetSampler) -> V {
+        wi.z.max(V::splat(0.0)).mul(V::splat(FRAC_1_PI))
     }
 }
 

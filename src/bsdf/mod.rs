@@ -57,6 +57,19 @@ pub trait Lobe: Send + Sync + std::fmt::Debug {
         }
     }
 
+    /// `p` times [`Self::pdf`] of the lanes of `mask` added to their entries of `acc`, bit for
+    /// bit `acc + p·pdf` per lane; other lanes kept. The default goes lane by lane; a built-in
+    /// lobe overrides it with one pass over lanes on `isa`.
+    fn add_pdf_lanes(&self, isa: Isa, q: &PdfQuery, p: f32, acc: &mut [f32; WIDTH]) {
+        let _ = isa;
+        let mut rest = q.mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            acc[lane] += p * self.pdf(q.wo.get(lane), q.wi.get(lane), q.sampler);
+        }
+    }
+
     /// A direction drawn from this lobe's own density [`Self::pdf`] (by `sampler` if the lobe
     /// is a microfacet lobe; other lobes ignore it); it may lie below the surface (f = 0 there),
     /// so the pdf stays a density over the whole sphere.
@@ -102,6 +115,60 @@ pub trait Lobe: Send + Sync + std::fmt::Debug {
 /// stand-ins and return 0, as the scalar test does.
 pub(crate) trait EvalLanes: Sync {
     fn eval_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>) -> V3<V>;
+    /// [`Lobe::pdf`] over lanes, for the samplers [`Self::pdf_over_lanes`] covers.
+    fn pdf_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>, sampler: MicrofacetSampler) -> V;
+    /// Whether [`Self::pdf_v`] covers `sampler`.
+    fn pdf_over_lanes(&self, _sampler: MicrofacetSampler) -> bool {
+        true
+    }
+}
+
+/// Lanes whose pdf a lobe is asked for: the directions in the shading frame, the sampler a
+/// microfacet lobe draws with, and the lanes.
+pub struct PdfQuery<'a> {
+    pub wo: &'a Soa3,
+    pub wi: &'a Soa3,
+    pub sampler: MicrofacetSampler,
+    pub mask: u32,
+}
+
+/// [`Lobe::add_pdf_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa` where
+/// it covers the sampler, else the lane-by-lane default.
+pub(crate) fn add_pdf_lanes<E: EvalLanes + Lobe>(
+    lobe: &E,
+    isa: Isa,
+    q: &PdfQuery,
+    p: f32,
+    acc: &mut [f32; WIDTH],
+) {
+    if !lobe.pdf_over_lanes(q.sampler) {
+        let mut rest = q.mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            acc[lane] += p * lobe.pdf(q.wo.get(lane), q.wi.get(lane), q.sampler);
+        }
+        return;
+    }
+    struct Kernel<'a, E> {
+        lobe: &'a E,
+        q: &'a PdfQuery<'a>,
+        p: f32,
+        acc: &'a mut [f32; WIDTH],
+    }
+    impl<E: EvalLanes> simd::Kernel for Kernel<'_, E> {
+        type Out = ();
+        #[inline(always)]
+        fn run<L: Lanes>(self) {
+            let q = self.q;
+            let pdf = self
+                .lobe
+                .pdf_v(V3::<L::V>::load(q.wo), V3::load(q.wi), q.sampler);
+            let acc = L::V::load(self.acc);
+            L::V::select(q.mask, acc.add(L::V::splat(self.p).mul(pdf)), acc).store(self.acc);
+        }
+    }
+    simd::run(isa, Kernel { lobe, q, p, acc });
 }
 
 /// [`Lobe::add_eval_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa`.
@@ -404,6 +471,51 @@ impl Bsdf {
         }
     }
 
+    /// [`Self::pdf`] of the lanes of `mask` into their entries of `out` (others kept), bit for
+    /// bit: the mixture's terms in lobe order, from zero, each lobe's
+    /// [`Lobe::add_pdf_lanes`] with its selection probability (one lobe: probability 1,
+    /// `0 + 1·p` being the scalar `0 + p`). Selection by albedo estimate, which depends on
+    /// each lane's view, goes lane by lane.
+    pub fn pdf_lanes(
+        &self,
+        isa: Isa,
+        wo: &Soa3,
+        wi: &Soa3,
+        sampling: BsdfSampling,
+        mask: u32,
+        out: &mut [f32; WIDTH],
+    ) {
+        if self.lobes.len() > 1 && sampling.lobes == LobeSelection::Albedo {
+            let mut rest = mask;
+            while rest != 0 {
+                let lane = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                out[lane] = self.pdf(wo.get(lane), wi.get(lane), sampling);
+            }
+            return;
+        }
+        for (lane, o) in out.iter_mut().enumerate() {
+            if mask >> lane & 1 != 0 {
+                *o = 0.0;
+            }
+        }
+        let q = PdfQuery {
+            wo,
+            wi,
+            sampler: sampling.microfacet,
+            mask,
+        };
+        if let [l] = &self.lobes[..] {
+            l.add_pdf_lanes(isa, &q, 1.0, out);
+            return;
+        }
+        for (l, &p) in self.lobes.iter().zip(&self.by_coefficient) {
+            if p > 0.0 {
+                l.add_pdf_lanes(isa, &q, p, out);
+            }
+        }
+    }
+
     /// Mixture pdf of [`Self::sample_local`] under `sampling`, in the local frame.
     pub fn pdf(&self, wo: Vec3, wi: Vec3, sampling: BsdfSampling) -> f32 {
         // One lobe has probability 1 under either policy: the sum below, without the
@@ -609,14 +721,48 @@ mod tests {
         None
     }
 
-    /// Every built-in material's f over lanes is its scalar f, bit for bit, on every ISA:
+    /// Where `pdf_lanes` on `isa` leaves `pdf` for some lane of `mask` (to the bit), or
+    /// changes a lane outside it; `perturb` alters the lanes' result first (negative control).
+    fn pdf_mismatch(
+        bsdf: &Bsdf,
+        isa: Isa,
+        (wo, wi): (&Soa3, &Soa3),
+        sampling: BsdfSampling,
+        mask: u32,
+        perturb: impl Fn(&mut [f32; WIDTH]),
+    ) -> Option<String> {
+        let mut out = [-7.5f32; WIDTH];
+        bsdf.pdf_lanes(isa, wo, wi, sampling, mask, &mut out);
+        perturb(&mut out);
+        for (lane, &got) in out.iter().enumerate() {
+            let want = if mask >> lane & 1 != 0 {
+                bsdf.pdf(wo.get(lane), wi.get(lane), sampling)
+            } else {
+                -7.5
+            };
+            if got.to_bits() != want.to_bits() {
+                return Some(format!(
+                    "{} {:?}: lane {lane} (wo {}, wi {}): {got} against {want}",
+                    isa.name(),
+                    sampling,
+                    wo.get(lane),
+                    wi.get(lane)
+                ));
+            }
+        }
+        None
+    }
+
+    /// Every built-in material's f and mixture pdf over lanes are its scalar ones, bit for
+    /// bit, on every ISA, the pdf under every BSDF sampling (each GGX sampler, selection by
+    /// coefficient and by albedo estimate):
     /// diffuse, Phong blends (lane by lane, the trait's default), GGX blends with each Fresnel
     /// (one, Schlick, conductors), isotropic and anisotropic, α from 1e-4 to 1, and
     /// principled materials; directions above, below and on the horizon, grazing, mirrored
     /// (wo + wi = 0, no half vector); lanes outside the mask keep what they held. Negative
-    /// control: one lane's result off by an ulp is caught.
+    /// control: one lane's f or pdf off by an ulp is caught.
     #[test]
-    fn eval_lanes_is_the_scalar_eval_on_every_isa() {
+    fn eval_and_pdf_lanes_are_the_scalar_ones_on_every_isa() {
         use crate::sampling::stream::SampleStream;
         use crate::sampling::warp::sample_uniform_sphere;
         let kd = Vec3::new(0.7, 0.4, 0.1);
@@ -682,10 +828,18 @@ mod tests {
                 2 => 1 << (round % 16),
                 _ => (rng.next_2d()[0] * 65536.0) as u32,
             };
+            let samplings: Vec<BsdfSampling> = [BsdfSampling::default()]
+                .into_iter()
+                .chain(BsdfSampling::variants())
+                .collect();
             for bsdf in &materials {
                 for isa in Isa::available() {
                     let miss = lanes_mismatch(bsdf, isa, &wo, &wi, mask, |_| {});
                     assert!(miss.is_none(), "{}", miss.unwrap());
+                    for &sampling in &samplings {
+                        let miss = pdf_mismatch(bsdf, isa, (&wo, &wi), sampling, mask, |_| {});
+                        assert!(miss.is_none(), "{}", miss.unwrap());
+                    }
                     checked += 1;
                 }
             }
@@ -699,9 +853,14 @@ mod tests {
         }
         let ggx = &materials[5];
         assert!(ggx.eval(wo.get(3), wi.get(3)).x > 0.0);
+        assert!(ggx.pdf(wo.get(3), wi.get(3), BsdfSampling::default()) > 0.0);
         for isa in Isa::available() {
             let off = |o: &mut Soa3| o.x[3] = f32::from_bits(o.x[3].to_bits() + 1);
             assert!(lanes_mismatch(ggx, isa, &wo, &wi, u32::from(u16::MAX), off).is_some());
+            let off = |o: &mut [f32; WIDTH]| o[3] = f32::from_bits(o[3].to_bits() + 1);
+            let all = u32::from(u16::MAX);
+            let sampling = BsdfSampling::default();
+            assert!(pdf_mismatch(ggx, isa, (&wo, &wi), sampling, all, off).is_some());
         }
     }
 

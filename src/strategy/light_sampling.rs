@@ -7,8 +7,8 @@ use super::{
     Estimator, Integrand, ProbePacket, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
     ShadowProbe, Strategy, env_method_name,
 };
-use crate::bsdf::LocalBsdf;
 use crate::bsdf::lambert::diffuse_lanes;
+use crate::bsdf::{BsdfSampling, LocalBsdf};
 use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
@@ -214,6 +214,16 @@ pub trait LightWeight {
     fn diffuse_lanes<V: Vector<WIDTH>>(&self, pdf: V, p_bsdf: V, delta: u32) -> V;
     /// Whether [`Self::diffuse_lanes`] reads `delta` (else it is not worked out).
     const READS_DELTA: bool = true;
+    /// The BSDF sampling whose pdf [`Self::lane`] weighs against; None where it reads none.
+    fn sampling(&self) -> Option<BsdfSampling> {
+        None
+    }
+    /// [`Self::lane`] given the BSDF pdf it would ask the material for, `p_bsdf` (worked out
+    /// over lanes by the caller, [`crate::bsdf::Bsdf::pdf_lanes`]): the same bits.
+    fn lane_given(&self, pdf: f32, p_bsdf: f32, light: usize) -> f32 {
+        let _ = (pdf, p_bsdf, light);
+        1.0
+    }
 }
 
 /// Light sampling alone: every weight is 1.
@@ -409,14 +419,27 @@ impl<'s> BoundLights<'s> {
             };
             delta |= (is_delta as u32) << lane;
         }
+        // The other materials' BSDF pdfs, which MIS weighs against, over lanes per material.
+        let others = valid & !diffuse;
+        let sampling = weight.sampling();
+        let mut p_bsdf = [0.0f32; LANES];
+        if let Some(sampling) = sampling {
+            packet.each_material(others, |bsdf, lanes| {
+                let wo = &packet.geo.wo_local;
+                bsdf.pdf_lanes(self.isa, wo, &r.local, sampling, lanes, &mut p_bsdf);
+            });
+        }
         shadow_values(
             self.isa,
             packet,
             &r,
             ls,
-            valid & !diffuse,
+            others,
             |lane, bsdf, local, value| {
-                let w = weight.lane(bsdf, r.pdf[lane], local, light[lane]);
+                let w = match sampling {
+                    Some(_) => weight.lane_given(r.pdf[lane], p_bsdf[lane], light[lane]),
+                    None => weight.lane(bsdf, r.pdf[lane], local, light[lane]),
+                };
                 out.shadow_value.set(lane, value * w);
             },
         );

@@ -290,6 +290,19 @@ impl LightWeight for MisEstimator<'_> {
     fn diffuse_lanes<V: Vector<WIDTH>>(&self, pdf: V, p_bsdf: V, delta: u32) -> V {
         self.delta_rule::<V, WIDTH>(pdf, p_bsdf, delta)
     }
+
+    fn sampling(&self) -> Option<BsdfSampling> {
+        Some(self.strategy.sampling)
+    }
+
+    /// [`Self::light_weight`] with the BSDF pdf given (a delta light's lane ignores it).
+    #[inline(always)]
+    fn lane_given(&self, pdf: f32, p_bsdf: f32, light: usize) -> f32 {
+        if self.lights.lights.get(light).is_delta() {
+            return self.delta_rule::<f32, 1>(pdf, 0.0, 1);
+        }
+        self.delta_rule::<f32, 1>(pdf, p_bsdf, 0)
+    }
 }
 
 impl Estimator for MisEstimator<'_> {
