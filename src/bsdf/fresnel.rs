@@ -34,10 +34,7 @@ impl Fresnel {
     /// [`Self::eval`] over lanes, the same operations in the same order per lane.
     #[inline(always)]
     pub fn eval_lanes<V: Vector<WIDTH>>(&self, cos: V) -> V3<V> {
-        let (zero, one) = (V::splat(0.0), V::splat(1.0));
-        // f32::clamp's two comparisons (a −0 stays −0, as there).
-        let c = V::select(cos.lt(zero), zero, cos);
-        let c = V::select(one.lt(c), one, c);
+        let c = clamp01_lanes(cos);
         match *self {
             Fresnel::One => V3::splat(Vec3::ONE),
             Fresnel::Schlick { f0 } => {
@@ -66,6 +63,14 @@ pub fn schlick_weight(c: f32) -> f32 {
     let m = 1.0 - c;
     let m2 = m * m;
     m2 * m2 * m
+}
+
+/// `c.clamp(0.0, 1.0)` over lanes: f32::clamp's two comparisons (a −0 stays −0, as there).
+#[inline(always)]
+pub fn clamp01_lanes<V: Vector<N>, const N: usize>(c: V) -> V {
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let c = V::select(c.lt(zero), zero, c);
+    V::select(one.lt(c), one, c)
 }
 
 /// [`schlick_weight`] over lanes.

@@ -62,12 +62,7 @@ pub trait Lobe: Send + Sync + std::fmt::Debug {
     /// lobe overrides it with one pass over lanes on `isa`.
     fn add_pdf_lanes(&self, isa: Isa, q: &PdfQuery, p: f32, acc: &mut [f32; WIDTH]) {
         let _ = isa;
-        let mut rest = q.mask;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            acc[lane] += p * self.pdf(q.wo.get(lane), q.wi.get(lane), q.sampler);
-        }
+        add_pdf_lane_by_lane(self, q, p, acc);
     }
 
     /// A direction drawn from this lobe's own density [`Self::pdf`] (by `sampler` if the lobe
@@ -132,6 +127,16 @@ pub struct PdfQuery<'a> {
     pub mask: u32,
 }
 
+/// `acc + p·pdf` lane by lane: [`Lobe::add_pdf_lanes`]' default.
+fn add_pdf_lane_by_lane<L: Lobe + ?Sized>(lobe: &L, q: &PdfQuery, p: f32, acc: &mut [f32; WIDTH]) {
+    let mut rest = q.mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        rest &= rest - 1;
+        acc[lane] += p * lobe.pdf(q.wo.get(lane), q.wi.get(lane), q.sampler);
+    }
+}
+
 /// [`Lobe::add_pdf_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa` where
 /// it covers the sampler, else the lane-by-lane default.
 pub(crate) fn add_pdf_lanes<E: EvalLanes + Lobe>(
@@ -142,12 +147,7 @@ pub(crate) fn add_pdf_lanes<E: EvalLanes + Lobe>(
     acc: &mut [f32; WIDTH],
 ) {
     if !lobe.pdf_over_lanes(q.sampler) {
-        let mut rest = q.mask;
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            acc[lane] += p * lobe.pdf(q.wo.get(lane), q.wi.get(lane), q.sampler);
-        }
+        add_pdf_lane_by_lane(lobe, q, p, acc);
         return;
     }
     struct Kernel<'a, E> {

@@ -9,7 +9,9 @@
 //! by-albedo selection policy; by coefficient, the GGX lobe weighs its F0 and the diffuse lobe
 //! its (1 − metallic)·base.
 
-use super::fresnel::{Fresnel, schlick_hemispherical_mean, schlick_weight, schlick_weight_lanes};
+use super::fresnel::{
+    Fresnel, clamp01_lanes, schlick_hemispherical_mean, schlick_weight, schlick_weight_lanes,
+};
 use super::ggx::{GgxLobe, parse_distribution};
 use super::material::{MaterialType, Params};
 use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery};
@@ -34,16 +36,12 @@ impl FresnelDiffuse {
     fn transmitted(&self, cos: f32) -> f32 {
         (1.0 - self.f0) * (1.0 - schlick_weight(cos.clamp(0.0, 1.0)))
     }
-}
 
-impl FresnelDiffuse {
-    /// [`Self::transmitted`] over lanes (the clamp's two comparisons as there).
+    /// [`Self::transmitted`] over lanes.
     #[inline(always)]
     fn transmitted_lanes<V: Vector<WIDTH>>(&self, cos: V) -> V {
-        let (zero, one) = (V::splat(0.0), V::splat(1.0));
-        let c = V::select(cos.lt(zero), zero, cos);
-        let c = V::select(one.lt(c), one, c);
-        V::splat(1.0 - self.f0).mul(one.sub(schlick_weight_lanes(c)))
+        let w = schlick_weight_lanes(clamp01_lanes(cos));
+        V::splat(1.0 - self.f0).mul(V::splat(1.0).sub(w))
     }
 }
 

@@ -208,8 +208,8 @@ fn cosine_query(packet: &ShadingPacket, u: [&[f32; WIDTH]; 2]) -> CosineQuery {
 /// material is cosine-sampled draw their directions over lanes ([`sample_cosine_lanes`]: the
 /// lobe drawn by u[2] does not change the direction), the others one by one. Diffuse lanes
 /// (a material of one built-in Lambert lobe) finish over lanes too, f = kd/π and pdf = cos/π
-/// with the scalar path's operations ([`DiffuseProbes`]); the others evaluate f over lanes,
-/// once per material ([`crate::bsdf::Bsdf::eval_lanes`]), and the mixture pdf lane by lane.
+/// with the scalar path's operations ([`DiffuseProbes`]); the others evaluate f and the
+/// mixture pdf over lanes, once per material ([`probe_lanes`]).
 #[inline(always)]
 pub fn bsdf_emission_packet(
     isa: Isa,
@@ -242,25 +242,12 @@ pub fn bsdf_emission_packet(
             local.set(lane, l);
         }
     }
-    if other != 0 {
-        // As `LocalBsdf::sample`: f and the pdf of the direction as rounded to world space.
-        let mut f = Soa3::default();
-        packet.each_material(other, |bsdf, lanes| {
-            bsdf.eval_lanes(isa, &packet.geo.wo_local, &local, lanes, &mut f);
-        });
-        probe_lanes(packet, other, &wi, &local, &f, sampling, out);
-    }
+    probe_lanes(isa, packet, other, (&wi, &local), sampling, out);
     if cosine | diffuse == 0 {
         return;
     }
     let r = sample_cosine_lanes(isa, &cosine_query(packet, [u0, u1]));
-    if cosine != 0 {
-        let mut f = Soa3::default();
-        packet.each_material(cosine, |bsdf, lanes| {
-            bsdf.eval_lanes(isa, &packet.geo.wo_local, &r.local, lanes, &mut f);
-        });
-        probe_lanes(packet, cosine, &r.wi, &r.local, &f, sampling, out);
-    }
+    probe_lanes(isa, packet, cosine, (&r.wi, &r.local), sampling, out);
     if diffuse != 0 {
         simd::run(
             isa,
@@ -276,27 +263,31 @@ pub fn bsdf_emission_packet(
 }
 
 /// The emission probes of the lanes of `mask` from their sampled directions (`wi` in the
-/// world, `local` in the shading frame) and f: each lane's mixture pdf, then
-/// [`emission_probe_lane`].
+/// world, `local` in the shading frame, as `LocalBsdf::sample` rounds them): f and the
+/// mixture pdf over lanes once per material, then [`emission_probe_lane`] per lane.
 #[inline(always)]
 fn probe_lanes(
+    isa: Isa,
     packet: &ShadingPacket,
     mask: u32,
-    wi: &Soa3,
-    local: &Soa3,
-    f: &Soa3,
+    (wi, local): (&Soa3, &Soa3),
     sampling: BsdfSampling,
     out: &mut ProbePacket,
 ) {
-    let mut rest = mask;
+    if mask == 0 {
+        return;
+    }
+    let (mut f, mut pdf) = (Soa3::default(), [0.0f32; WIDTH]);
+    let wo = &packet.geo.wo_local;
+    packet.each_material(mask, |bsdf, lanes| {
+        bsdf.eval_lanes(isa, wo, local, lanes, &mut f);
+        bsdf.pdf_lanes(isa, wo, local, sampling, lanes, &mut pdf);
+    });
+    let mut rest = mask & packet.mask;
     while rest != 0 {
         let lane = rest.trailing_zeros() as usize;
         rest &= rest - 1;
-        let Some(bsdf) = packet.local_bsdf(lane) else {
-            continue;
-        };
-        let pdf = bsdf.pdf_local(local.get(lane), sampling);
-        let e = emission_probe_lane(packet, lane, wi.get(lane), f.get(lane), pdf).emission;
+        let e = emission_probe_lane(packet, lane, wi.get(lane), f.get(lane), pdf[lane]).emission;
         out.set_emission(lane, e);
     }
 }

@@ -7,8 +7,8 @@ use super::{
     Estimator, Integrand, ProbePacket, Probes, ShadingLanes, ShadingPacket, ShadingPoint,
     ShadowProbe, Strategy, env_method_name,
 };
+use crate::bsdf::BsdfSampling;
 use crate::bsdf::lambert::diffuse_lanes;
-use crate::bsdf::{BsdfSampling, LocalBsdf};
 use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
@@ -172,10 +172,10 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
     out
 }
 
-/// Each shadow lane's unweighted value f·L·cos θ/pdf, handed to `each(lane, bsdf, local,
-/// value)` with the lane's material and the direction in its shading frame. f is evaluated
-/// over lanes, once for each material among the lanes ([`Bsdf::eval_lanes`]: a pixel's
-/// samples mostly share one), from the packet's rows (no point is built).
+/// Each shadow lane's unweighted value f·L·cos θ/pdf, handed to `each(lane, local, value)`
+/// with the direction in the lane's shading frame. f is evaluated over lanes, once for each
+/// material among the lanes ([`Bsdf::eval_lanes`]: a pixel's samples mostly share one), from
+/// the packet's rows (no point is built).
 #[inline(always)]
 fn shadow_values(
     isa: Isa,
@@ -183,7 +183,7 @@ fn shadow_values(
     r: &ShadowRays,
     ls: &LaneSamples,
     valid: u32,
-    mut each: impl FnMut(usize, &LocalBsdf, Vec3, Vec3),
+    mut each: impl FnMut(usize, Vec3, Vec3),
 ) {
     let mut f = Soa3::default();
     packet.each_material(valid, |bsdf, lanes| {
@@ -193,45 +193,41 @@ fn shadow_values(
     while rest != 0 {
         let lane = rest.trailing_zeros() as usize;
         rest &= rest - 1;
-        let bsdf = packet
-            .local_bsdf(lane)
-            .expect("a valid shadow lane has a point");
         let local = r.local.get(lane);
         let value = f.get(lane) * ls.radiance.get(lane) * r.factor[lane];
-        each(lane, &bsdf, local, value);
+        each(lane, local, value);
     }
 }
 
 /// How a light sample's value is weighted: 1 for light sampling alone, the MIS weight for
-/// MIS. The same rule twice: lane by lane for any material, and over lanes for diffuse ones.
+/// MIS, against the BSDF pdf of the sample's direction under [`Self::sampling`] (which the
+/// caller works out over lanes, [`crate::bsdf::Bsdf::pdf_lanes`]). The same rule twice: lane
+/// by lane, and over lanes for diffuse materials.
 pub trait LightWeight {
-    /// The weight of a light sample of light `light` with pdf `pdf` (selection included),
-    /// direction `local` in the shading frame, from a point of material `bsdf`.
-    fn lane(&self, bsdf: &LocalBsdf, pdf: f32, local: Vec3, light: usize) -> f32;
+    /// The BSDF sampling whose pdf the weight is against; None where the weight reads none
+    /// (then `p_bsdf` is 0 and not worked out).
+    fn sampling(&self) -> Option<BsdfSampling>;
+    /// The weight of a light sample of light `light` with pdf `pdf` (selection included)
+    /// against the BSDF pdf `p_bsdf` of its direction.
+    fn lane(&self, pdf: f32, p_bsdf: f32, light: usize) -> f32;
     /// [`Self::lane`] over lanes for diffuse materials, whose BSDF pdf `p_bsdf` (the cosine
     /// density) is given; `delta` holds the lanes whose light is a delta light. Bit for bit
     /// `lane` in every lane it is asked for.
     fn diffuse_lanes<V: Vector<WIDTH>>(&self, pdf: V, p_bsdf: V, delta: u32) -> V;
     /// Whether [`Self::diffuse_lanes`] reads `delta` (else it is not worked out).
     const READS_DELTA: bool = true;
-    /// The BSDF sampling whose pdf [`Self::lane`] weighs against; None where it reads none.
-    fn sampling(&self) -> Option<BsdfSampling> {
-        None
-    }
-    /// [`Self::lane`] given the BSDF pdf it would ask the material for, `p_bsdf` (worked out
-    /// over lanes by the caller, [`crate::bsdf::Bsdf::pdf_lanes`]): the same bits.
-    fn lane_given(&self, pdf: f32, p_bsdf: f32, light: usize) -> f32 {
-        let _ = (pdf, p_bsdf, light);
-        1.0
-    }
 }
 
 /// Light sampling alone: every weight is 1.
 pub struct Unweighted;
 
 impl LightWeight for Unweighted {
+    fn sampling(&self) -> Option<BsdfSampling> {
+        None
+    }
+
     #[inline(always)]
-    fn lane(&self, _: &LocalBsdf, _: f32, _: Vec3, _: usize) -> f32 {
+    fn lane(&self, _: f32, _: f32, _: usize) -> f32 {
         1.0
     }
 
@@ -354,7 +350,7 @@ impl<'s> BoundLights<'s> {
             &r,
             &ls,
             r.valid & packet.mask,
-            |lane, _, local, value| {
+            |lane, local, value| {
                 let mut sample = ls
                     .get(lane)
                     .expect("a valid shadow lane has a light sample");
@@ -373,8 +369,8 @@ impl<'s> BoundLights<'s> {
     /// [`LightWeight`] (1 for plain light sampling, the MIS weight for MIS: `value · w`, as the
     /// scalar path's `value *= w`). Diffuse lanes (a material of one built-in Lambert lobe)
     /// evaluate f = kd/π, the value and the weight over lanes, with the scalar operations in
-    /// their order ([`DiffuseValues`]); the others evaluate f over lanes once per material
-    /// and weigh lane by lane.
+    /// their order ([`DiffuseValues`]); the others evaluate f and the BSDF pdf the weight
+    /// reads over lanes once per material, and weigh lane by lane.
     #[inline(always)]
     pub fn probe_packet_rows<W: LightWeight>(
         &self,
@@ -421,28 +417,17 @@ impl<'s> BoundLights<'s> {
         }
         // The other materials' BSDF pdfs, which MIS weighs against, over lanes per material.
         let others = valid & !diffuse;
-        let sampling = weight.sampling();
         let mut p_bsdf = [0.0f32; LANES];
-        if let Some(sampling) = sampling {
+        if let Some(sampling) = weight.sampling() {
             packet.each_material(others, |bsdf, lanes| {
                 let wo = &packet.geo.wo_local;
                 bsdf.pdf_lanes(self.isa, wo, &r.local, sampling, lanes, &mut p_bsdf);
             });
         }
-        shadow_values(
-            self.isa,
-            packet,
-            &r,
-            ls,
-            others,
-            |lane, bsdf, local, value| {
-                let w = match sampling {
-                    Some(_) => weight.lane_given(r.pdf[lane], p_bsdf[lane], light[lane]),
-                    None => weight.lane(bsdf, r.pdf[lane], local, light[lane]),
-                };
-                out.shadow_value.set(lane, value * w);
-            },
-        );
+        shadow_values(self.isa, packet, &r, ls, others, |lane, _, value| {
+            let w = weight.lane(r.pdf[lane], p_bsdf[lane], light[lane]);
+            out.shadow_value.set(lane, value * w);
+        });
         if diffuse != 0 {
             simd::run(
                 self.isa,

@@ -255,11 +255,13 @@ impl MisEstimator<'_> {
     /// reachable by light sampling only: its weight is 1 (`value · 1` is `value`).
     #[inline(always)]
     fn light_weight(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3, light: usize) -> f32 {
-        if self.lights.lights.get(light).is_delta() {
-            return self.delta_rule::<f32, 1>(pdf, 0.0, 1);
-        }
-        let p_bsdf = bsdf.pdf_local(local, self.strategy.sampling);
-        self.delta_rule::<f32, 1>(pdf, p_bsdf, 0)
+        // A delta light's weight does not read the BSDF pdf: it is not worked out.
+        let p_bsdf = if self.lights.lights.get(light).is_delta() {
+            0.0
+        } else {
+            bsdf.pdf_local(local, self.strategy.sampling)
+        };
+        LightWeight::lane(self, pdf, p_bsdf, light)
     }
 
     /// The weight of light samples with pdf `pdf` against BSDF pdf `p_bsdf`, 1 in the lanes
@@ -281,27 +283,22 @@ impl MisEstimator<'_> {
 }
 
 impl LightWeight for MisEstimator<'_> {
+    fn sampling(&self) -> Option<BsdfSampling> {
+        Some(self.strategy.sampling)
+    }
+
+    /// 1 for a delta light (reachable by light sampling only), else the heuristic.
     #[inline(always)]
-    fn lane(&self, bsdf: &LocalBsdf, pdf: f32, local: glam::Vec3, light: usize) -> f32 {
-        self.light_weight(bsdf, pdf, local, light)
+    fn lane(&self, pdf: f32, p_bsdf: f32, light: usize) -> f32 {
+        if self.lights.lights.get(light).is_delta() {
+            return self.delta_rule::<f32, 1>(pdf, 0.0, 1);
+        }
+        self.delta_rule::<f32, 1>(pdf, p_bsdf, 0)
     }
 
     #[inline(always)]
     fn diffuse_lanes<V: Vector<WIDTH>>(&self, pdf: V, p_bsdf: V, delta: u32) -> V {
         self.delta_rule::<V, WIDTH>(pdf, p_bsdf, delta)
-    }
-
-    fn sampling(&self) -> Option<BsdfSampling> {
-        Some(self.strategy.sampling)
-    }
-
-    /// [`Self::light_weight`] with the BSDF pdf given (a delta light's lane ignores it).
-    #[inline(always)]
-    fn lane_given(&self, pdf: f32, p_bsdf: f32, light: usize) -> f32 {
-        if self.lights.lights.get(light).is_delta() {
-            return self.delta_rule::<f32, 1>(pdf, 0.0, 1);
-        }
-        self.delta_rule::<f32, 1>(pdf, p_bsdf, 0)
     }
 }
 
