@@ -6,7 +6,7 @@
 
 use super::fresnel::{Fresnel, conductor_preset};
 use super::material::{MaterialType, Params};
-use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery, SampleQuery};
 use crate::error::Result;
 pub use crate::sampling::microfacet::Ggx;
 use crate::sampling::microfacet::half_vector;
@@ -55,6 +55,10 @@ impl Lobe for GgxLobe {
             return Vec3::NEG_Z;
         }
         sampler.sample(&self.dist, wo, u)
+    }
+
+    fn sample_lanes(&self, isa: Isa, q: &SampleQuery, out: &mut Soa3) {
+        super::sample_lanes(self, isa, q, out);
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3, sampler: MicrofacetSampler) -> f32 {
@@ -128,6 +132,16 @@ impl EvalLanes for GgxLobe {
 
     fn pdf_over_lanes(&self, sampler: MicrofacetSampler) -> bool {
         sampler != MicrofacetSampler::VndfBounded
+    }
+
+    /// [`Lobe::sample`]: the sampler's own code over lanes; lanes seen edge-on (wo.z ≤ 0)
+    /// draw with a stand-in view (+z) and return −z, as the scalar lobe does.
+    #[inline(always)]
+    fn sample_v<V: Vector<WIDTH>>(&self, wo: V3<V>, u: [V; 2], sampler: MicrofacetSampler) -> V3<V> {
+        let above = !wo.z.le(V::splat(0.0));
+        let wo = V3::select(above, wo, V3::splat(Vec3::Z));
+        let w = sampler.sample_v(&self.dist, wo, u[0], u[1]);
+        V3::select(above, w, V3::splat(Vec3::NEG_Z))
     }
 }
 

@@ -2,9 +2,9 @@
 //! material type.
 
 use super::material::{MaterialType, Params};
-use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery, SampleQuery};
 use crate::error::Result;
-use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::sampling::warp::{cosine_hemisphere, cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
 use glam::Vec3;
 use std::f32::consts::FRAC_1_PI;
@@ -34,6 +34,10 @@ impl Lobe for Lambert {
         sample_cosine_hemisphere(u)
     }
 
+    fn sample_lanes(&self, isa: Isa, q: &SampleQuery, out: &mut Soa3) {
+        super::sample_lanes(self, isa, q, out);
+    }
+
     fn pdf(&self, _wo: Vec3, wi: Vec3, _: MicrofacetSampler) -> f32 {
         cosine_hemisphere_pdf(wi.z)
     }
@@ -59,6 +63,18 @@ impl EvalLanes for Lambert {
     fn pdf_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, wi: V3<V>, _: MicrofacetSampler) -> V {
         wi.z.max(V::splat(0.0)).mul(V::splat(FRAC_1_PI))
     }
+
+    #[inline(always)]
+    fn sample_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, u: [V; 2], _: MicrofacetSampler) -> V3<V> {
+        cosine_lanes(u)
+    }
+}
+
+/// [`sample_cosine_hemisphere`] over lanes (the same warp code).
+#[inline(always)]
+pub(crate) fn cosine_lanes<V: Vector<WIDTH>>(u: [V; 2]) -> V3<V> {
+    let (x, y, z) = cosine_hemisphere(u[0], u[1]);
+    V3 { x, y, z }
 }
 
 /// `Bsdf::eval` and `Bsdf::pdf` of a diffuse material (its one Lambert lobe of `kd`) over

@@ -70,6 +70,20 @@ pub trait Lobe: Send + Sync + std::fmt::Debug {
     /// so the pdf stays a density over the whole sphere.
     fn sample(&self, wo: Vec3, u: [f32; 2], sampler: MicrofacetSampler) -> Vec3;
 
+    /// [`Self::sample`] of the lanes of `q.mask` into their rows of `out`, bit for bit; other
+    /// rows kept. The default goes lane by lane; a built-in lobe overrides it with one pass
+    /// over lanes on `isa`.
+    fn sample_lanes(&self, isa: Isa, q: &SampleQuery, out: &mut Soa3) {
+        let _ = isa;
+        let mut rest = q.mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let u = [q.u[0][lane], q.u[1][lane]];
+            out.set(lane, self.sample(q.wo.get(lane), u, q.sampler));
+        }
+    }
+
     /// Solid-angle density of [`Self::sample`].
     fn pdf(&self, wo: Vec3, wi: Vec3, sampler: MicrofacetSampler) -> f32;
 
@@ -116,6 +130,18 @@ pub(crate) trait EvalLanes: Sync {
     fn pdf_over_lanes(&self, _sampler: MicrofacetSampler) -> bool {
         true
     }
+    /// [`Lobe::sample`] over lanes, written on the scalar sampler's own lane code.
+    fn sample_v<V: Vector<WIDTH>>(&self, wo: V3<V>, u: [V; 2], sampler: MicrofacetSampler)
+    -> V3<V>;
+}
+
+/// Lanes a lobe draws directions for: the views in the shading frame, two sample numbers per
+/// lane, the sampler a microfacet lobe draws with, and the lanes.
+pub struct SampleQuery<'a> {
+    pub wo: &'a Soa3,
+    pub u: [&'a [f32; WIDTH]; 2],
+    pub sampler: MicrofacetSampler,
+    pub mask: u32,
 }
 
 /// Lanes whose pdf a lobe is asked for: the directions in the shading frame, the sampler a
@@ -169,6 +195,26 @@ pub(crate) fn add_pdf_lanes<E: EvalLanes + Lobe>(
         }
     }
     simd::run(isa, Kernel { lobe, q, p, acc });
+}
+
+/// [`Lobe::sample_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa`.
+pub(crate) fn sample_lanes<E: EvalLanes>(lobe: &E, isa: Isa, q: &SampleQuery, out: &mut Soa3) {
+    struct Kernel<'a, E> {
+        lobe: &'a E,
+        q: &'a SampleQuery<'a>,
+        out: &'a mut Soa3,
+    }
+    impl<E: EvalLanes> simd::Kernel for Kernel<'_, E> {
+        type Out = ();
+        #[inline(always)]
+        fn run<L: Lanes>(self) {
+            let q = self.q;
+            let u = [L::V::load(q.u[0]), L::V::load(q.u[1])];
+            let w = self.lobe.sample_v(V3::<L::V>::load(q.wo), u, q.sampler);
+            V3::select(q.mask, w, V3::load(self.out)).store(self.out);
+        }
+    }
+    simd::run(isa, Kernel { lobe, q, out });
 }
 
 /// [`Lobe::add_eval_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa`.
@@ -540,17 +586,59 @@ impl Bsdf {
         if let [l] = &self.lobes[..] {
             return l.sample(wo, [u[0], u[1]], sampling.microfacet);
         }
-        let probs = self.selection(sampling.lobes, wo);
+        let chosen = self.choose(&self.selection(sampling.lobes, wo), u[2]);
+        self.lobes[chosen].sample(wo, [u[0], u[1]], sampling.microfacet)
+    }
+
+    /// The lobe that `u` picks from the probabilities `probs` (the last one if rounding leaves
+    /// the running sum below u).
+    fn choose(&self, probs: &Selection, u: f32) -> usize {
         let mut cdf = 0.0;
-        let mut chosen = self.lobes.len() - 1;
         for (i, &p) in probs[..self.lobes.len()].iter().enumerate() {
             cdf += p;
-            if u[2] < cdf {
-                chosen = i;
-                break;
+            if u < cdf {
+                return i;
             }
         }
-        self.lobes[chosen].sample(wo, [u[0], u[1]], sampling.microfacet)
+        self.lobes.len() - 1
+    }
+
+    /// [`Self::sample_local`] of the lanes of `mask` (views `wo`, numbers `u`) into their rows
+    /// of `out`, bit for bit; other rows kept. Each lane picks its lobe as the scalar path does;
+    /// then each lobe draws its lanes with [`Lobe::sample_lanes`].
+    pub fn sample_local_lanes(
+        &self,
+        isa: Isa,
+        wo: &Soa3,
+        u: [&[f32; WIDTH]; 3],
+        sampling: BsdfSampling,
+        mask: u32,
+        out: &mut Soa3,
+    ) {
+        let query = |mask| SampleQuery {
+            wo,
+            u: [u[0], u[1]],
+            sampler: sampling.microfacet,
+            mask,
+        };
+        if let [l] = &self.lobes[..] {
+            l.sample_lanes(isa, &query(mask), out);
+            return;
+        }
+        let fixed = (sampling.lobes == LobeSelection::Coefficient).then_some(self.by_coefficient);
+        let mut chosen = [0u32; MAX_LOBES];
+        let mut rest = mask;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            let probs = fixed.unwrap_or_else(|| self.selection(sampling.lobes, wo.get(lane)));
+            chosen[self.choose(&probs, u[2][lane])] |= 1 << lane;
+        }
+        for (l, &lanes) in self.lobes.iter().zip(&chosen) {
+            if lanes != 0 {
+                l.sample_lanes(isa, &query(lanes), out);
+            }
+        }
     }
 }
 
@@ -659,13 +747,7 @@ pub fn sample_cosine_lanes(isa: Isa, q: &CosineQuery) -> CosineLanes {
             let (s, t, n) = (V3::<L::V>::load(&q.s), V3::load(&q.t), V3::load(&q.n));
             let (x, y, z) =
                 crate::sampling::warp::cosine_hemisphere(L::V::load(&q.u[0]), L::V::load(&q.u[1]));
-            // Frame::to_world and to_local in glam's order.
-            let wi = s.scale(x) + t.scale(y) + n.scale(z);
-            let local = V3 {
-                x: wi.dot(s),
-                y: wi.dot(t),
-                z: wi.dot(n),
-            };
+            let (wi, local) = to_world_and_back([s, t, n], V3 { x, y, z });
             let mut out = CosineLanes::default();
             wi.store(&mut out.wi);
             local.store(&mut out.local);
@@ -674,6 +756,70 @@ pub fn sample_cosine_lanes(isa: Isa, q: &CosineQuery) -> CosineLanes {
         }
     }
     simd::run(isa, Kernel(q))
+}
+
+/// `frame.to_world(v)` and `frame.to_local` of that, over lanes with glam's operations in
+/// glam's order (frames as their axes [s, t, n]): a sampled direction as rounded to world
+/// space, and that direction back in the frame, where f and the pdf are evaluated (as
+/// [`LocalBsdf::sample_direction`] does).
+#[inline(always)]
+pub fn to_world_and_back<V: Vector<WIDTH>>([s, t, n]: [V3<V>; 3], v: V3<V>) -> (V3<V>, V3<V>) {
+    let wi = s.scale(v.x) + t.scale(v.y) + n.scale(v.z);
+    let local = V3 {
+        x: wi.dot(s),
+        y: wi.dot(t),
+        z: wi.dot(n),
+    };
+    (wi, local)
+}
+
+/// Frames over lanes: the axes of each lane's shading frame, the rows [`to_world_and_back`]
+/// loads.
+#[derive(Clone, Copy)]
+pub struct FrameRows<'a> {
+    pub s: &'a Soa3,
+    pub t: &'a Soa3,
+    pub n: &'a Soa3,
+}
+
+/// [`LocalBsdf::sample_direction`] of the lanes of `mask` whose directions in the frame
+/// ([`Bsdf::sample_local_lanes`]) are `local`: their world directions into `wi`, and those
+/// back in the frame into `back`, bit for bit; other rows kept.
+pub fn directions_to_world(
+    isa: Isa,
+    frames: FrameRows,
+    local: &Soa3,
+    mask: u32,
+    (wi, back): (&mut Soa3, &mut Soa3),
+) {
+    struct Kernel<'a> {
+        frames: FrameRows<'a>,
+        local: &'a Soa3,
+        mask: u32,
+        wi: &'a mut Soa3,
+        back: &'a mut Soa3,
+    }
+    impl simd::Kernel for Kernel<'_> {
+        type Out = ();
+        #[inline(always)]
+        fn run<L: Lanes>(self) {
+            let f = self.frames;
+            let axes = [V3::<L::V>::load(f.s), V3::load(f.t), V3::load(f.n)];
+            let (w, b) = to_world_and_back(axes, V3::load(self.local));
+            V3::select(self.mask, w, V3::load(self.wi)).store(self.wi);
+            V3::select(self.mask, b, V3::load(self.back)).store(self.back);
+        }
+    }
+    simd::run(
+        isa,
+        Kernel {
+            frames,
+            local,
+            mask,
+            wi,
+            back,
+        },
+    );
 }
 
 /// The χ² cases of BSDF sampling: each material type's, in [`MATERIALS`] order (from the
@@ -753,18 +899,10 @@ mod tests {
         None
     }
 
-    /// Every built-in material's f and mixture pdf over lanes are its scalar ones, bit for
-    /// bit, on every ISA, the pdf under every BSDF sampling (each GGX sampler, selection by
-    /// coefficient and by albedo estimate):
-    /// diffuse, Phong blends (lane by lane, the trait's default), GGX blends with each Fresnel
-    /// (one, Schlick, conductors), isotropic and anisotropic, α from 1e-4 to 1, and
-    /// principled materials; directions above, below and on the horizon, grazing, mirrored
-    /// (wo + wi = 0, no half vector); lanes outside the mask keep what they held. Negative
-    /// control: one lane's f or pdf off by an ulp is caught.
-    #[test]
-    fn eval_and_pdf_lanes_are_the_scalar_ones_on_every_isa() {
-        use crate::sampling::stream::SampleStream;
-        use crate::sampling::warp::sample_uniform_sphere;
+    /// Every built-in material kind the lane tests cover: diffuse, Phong blends (lane by lane,
+    /// the trait's defaults), GGX blends with each Fresnel (one, Schlick, conductors),
+    /// isotropic and anisotropic, α from 1e-4 to 1, and principled materials.
+    fn lane_test_materials() -> Vec<Bsdf> {
         let kd = Vec3::new(0.7, 0.4, 0.1);
         let ks = Vec3::new(0.3, 0.5, 0.2);
         let mut materials = vec![
@@ -802,6 +940,22 @@ mod tests {
                 .bsdf(),
             );
         }
+        materials
+    }
+
+    /// Every built-in material's f and mixture pdf over lanes are its scalar ones, bit for
+    /// bit, on every ISA, the pdf under every BSDF sampling (each GGX sampler, selection by
+    /// coefficient and by albedo estimate):
+    /// diffuse, Phong blends (lane by lane, the trait's default), GGX blends with each Fresnel
+    /// (one, Schlick, conductors), isotropic and anisotropic, α from 1e-4 to 1, and
+    /// principled materials; directions above, below and on the horizon, grazing, mirrored
+    /// (wo + wi = 0, no half vector); lanes outside the mask keep what they held. Negative
+    /// control: one lane's f or pdf off by an ulp is caught.
+    #[test]
+    fn eval_and_pdf_lanes_are_the_scalar_ones_on_every_isa() {
+        use crate::sampling::stream::SampleStream;
+        use crate::sampling::warp::sample_uniform_sphere;
+        let materials = lane_test_materials();
         let mut rng = SampleStream::new(11, 2, 4, 1);
         let up = |v: Vec3| Vec3::new(v.x, v.y, v.z.abs());
         let mut checked = 0;
@@ -963,6 +1117,161 @@ mod tests {
             }
         }
         assert!(checked >= 64 * WIDTH);
+    }
+
+    /// Where `sample_local_lanes` on `isa` leaves `sample_local` for some lane of `mask` (to
+    /// the bit), or changes a lane outside it; `perturb` alters the lanes' result first
+    /// (negative control).
+    fn sample_mismatch(
+        bsdf: &Bsdf,
+        isa: Isa,
+        (wo, u): (&Soa3, [&[f32; WIDTH]; 3]),
+        sampling: BsdfSampling,
+        mask: u32,
+        perturb: impl Fn(&mut Soa3),
+    ) -> Option<String> {
+        let before = Soa3::splat(Vec3::new(-7.0, 0.5, 3.0));
+        let mut out = before;
+        bsdf.sample_local_lanes(isa, wo, u, sampling, mask, &mut out);
+        perturb(&mut out);
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for lane in 0..WIDTH {
+            let ul = u.map(|row| row[lane]);
+            let want = if mask >> lane & 1 != 0 {
+                bsdf.sample_local(wo.get(lane), ul, sampling)
+            } else {
+                before.get(lane)
+            };
+            if bits(out.get(lane)) != bits(want) {
+                return Some(format!(
+                    "{} {sampling:?}: lane {lane} (wo {}, u {ul:?}): {} against {want}",
+                    isa.name(),
+                    wo.get(lane),
+                    out.get(lane)
+                ));
+            }
+        }
+        None
+    }
+
+    /// Every built-in material's BSDF samples over lanes are its scalar samples, bit for bit,
+    /// on every ISA, under every BSDF sampling (each GGX sampler; lobes chosen by coefficient
+    /// and by albedo estimate): views from the normal to edge-on and below (a GGX lobe returns
+    /// −z there), numbers at 0, the quarter turns and 1 − ε as well as random ones; lanes
+    /// outside the mask keep what they held. Then the frame round trip over lanes is the
+    /// scalar `to_world` and `to_local`. Negative control: one lane off by an ulp is caught.
+    #[test]
+    fn sample_lanes_are_the_scalar_samples_on_every_isa() {
+        use crate::sampling::stream::{ONE_MINUS_EPSILON, SampleStream};
+        use crate::sampling::warp::sample_uniform_sphere;
+        let materials = lane_test_materials();
+        let samplings: Vec<BsdfSampling> = [BsdfSampling::default()]
+            .into_iter()
+            .chain(BsdfSampling::variants())
+            .collect();
+        let mut rng = SampleStream::new(12, 3, 5, 2);
+        let special = [0.0, 0.25, 0.5, 0.75, ONE_MINUS_EPSILON, 0.125, 1e-7];
+        let mut checked = 0;
+        for round in 0..120 {
+            let mut wo = Soa3::default();
+            let mut u = [[0.0f32; WIDTH]; 3];
+            for lane in 0..WIDTH {
+                let a = sample_uniform_sphere(rng.next_2d());
+                let o = match (lane + round) % 6 {
+                    0 => Vec3::Z,
+                    1 => Vec3::new(a.x, a.y, 0.0).normalize(), // edge-on
+                    2 => Vec3::new(a.x, a.y, 1e-6).normalize(), // grazing
+                    3 => a,                                    // either side
+                    _ => Vec3::new(a.x, a.y, a.z.abs()),
+                };
+                wo.set(lane, o);
+                let r = rng.next_2d();
+                let v = rng.next_2d();
+                u[0][lane] = if round % 3 == 0 {
+                    special[(lane + round) % 7]
+                } else {
+                    r[0]
+                };
+                u[1][lane] = if round % 5 == 1 {
+                    special[lane % 7]
+                } else {
+                    r[1]
+                };
+                u[2][lane] = v[0];
+            }
+            let mask = match round % 4 {
+                0 => u32::from(u16::MAX),
+                1 => 0xa5a5,
+                2 => 1 << (round % 16),
+                _ => (rng.next_2d()[0] * 65536.0) as u32,
+            };
+            let u = [&u[0], &u[1], &u[2]];
+            for bsdf in &materials {
+                for isa in Isa::available() {
+                    for &sampling in &samplings {
+                        let miss = sample_mismatch(bsdf, isa, (&wo, u), sampling, mask, |_| {});
+                        assert!(miss.is_none(), "{}", miss.unwrap());
+                        checked += 1;
+                    }
+                }
+            }
+            // The frame round trip of those directions, in frames about random normals.
+            let (mut s, mut t, mut n) = (Soa3::default(), Soa3::default(), Soa3::default());
+            let mut local = Soa3::default();
+            materials[7].sample_local_lanes(
+                Isa::available()[0],
+                &wo,
+                u,
+                BsdfSampling::default(),
+                u32::from(u16::MAX),
+                &mut local,
+            );
+            for lane in 0..WIDTH {
+                let f = Frame::from_normal(sample_uniform_sphere(rng.next_2d()));
+                s.set(lane, f.s);
+                t.set(lane, f.t);
+                n.set(lane, f.n);
+            }
+            for isa in Isa::available() {
+                let before = Soa3::splat(Vec3::new(2.0, -1.0, 0.5));
+                let (mut wi, mut back) = (before, before);
+                let frames = FrameRows {
+                    s: &s,
+                    t: &t,
+                    n: &n,
+                };
+                directions_to_world(isa, frames, &local, mask, (&mut wi, &mut back));
+                for lane in 0..WIDTH {
+                    let f = Frame {
+                        s: s.get(lane),
+                        t: t.get(lane),
+                        n: n.get(lane),
+                    };
+                    let w = f.to_world(local.get(lane));
+                    let (want_wi, want_back) = if mask >> lane & 1 != 0 {
+                        (w, f.to_local(w))
+                    } else {
+                        (before.get(lane), before.get(lane))
+                    };
+                    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                    assert_eq!(bits(wi.get(lane)), bits(want_wi), "{isa:?} lane {lane}");
+                    assert_eq!(bits(back.get(lane)), bits(want_back), "{isa:?} lane {lane}");
+                }
+            }
+        }
+        assert!(checked > 10_000, "{checked}");
+        // Negative control: the comparison resolves one ulp in one lane.
+        let wo = Soa3::splat(Vec3::new(0.1, 0.2, 0.97).normalize());
+        let uu = [[0.3f32; WIDTH], [0.6f32; WIDTH], [0.9f32; WIDTH]];
+        let u = [&uu[0], &uu[1], &uu[2]];
+        let ggx = &materials[5];
+        for isa in Isa::available() {
+            let off = |o: &mut Soa3| o.y[3] = f32::from_bits(o.y[3].to_bits() + 1);
+            let all = u32::from(u16::MAX);
+            let sampling = BsdfSampling::default();
+            assert!(sample_mismatch(ggx, isa, (&wo, u), sampling, all, |_| {}).is_none());
+            assert!(sample_mismatch(ggx, isa, (&wo, u), sampling, all, off).is_some());
+        }
     }
 
     /// Selection by coefficient luminance: probabilities sum to one and follow the weights.

@@ -14,7 +14,7 @@ use super::fresnel::{
 };
 use super::ggx::{GgxLobe, parse_distribution};
 use super::material::{MaterialType, Params};
-use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery};
+use super::{Bsdf, EvalLanes, Lobe, MicrofacetSampler, PdfQuery, SampleQuery};
 use crate::error::Result;
 use crate::sampling::warp::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::simd::{Isa, Soa3, V3, Vector, WIDTH};
@@ -61,6 +61,11 @@ impl EvalLanes for FresnelDiffuse {
     fn pdf_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, wi: V3<V>, _: MicrofacetSampler) -> V {
         wi.z.max(V::splat(0.0)).mul(V::splat(FRAC_1_PI))
     }
+
+    #[inline(always)]
+    fn sample_v<V: Vector<WIDTH>>(&self, _wo: V3<V>, u: [V; 2], _: MicrofacetSampler) -> V3<V> {
+        super::lambert::cosine_lanes(u)
+    }
 }
 
 impl Lobe for FresnelDiffuse {
@@ -81,6 +86,10 @@ impl Lobe for FresnelDiffuse {
 
     fn sample(&self, _wo: Vec3, u: [f32; 2], _: MicrofacetSampler) -> Vec3 {
         sample_cosine_hemisphere(u)
+    }
+
+    fn sample_lanes(&self, isa: Isa, q: &SampleQuery, out: &mut Soa3) {
+        super::sample_lanes(self, isa, q, out);
     }
 
     fn pdf(&self, _wo: Vec3, wi: Vec3, _: MicrofacetSampler) -> f32 {

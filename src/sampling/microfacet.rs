@@ -10,6 +10,7 @@
 //! stretched length t(ω) = |(αx ωx, αy ωy, ωz)| so that nothing divides by cos θ (Heitz 2014,
 //! "Understanding the masking-shadowing function", eqs. 72 and 99 rearranged).
 
+use crate::sampling::warp::cos_sin_turns;
 use crate::simd::{V3, Vector, WIDTH};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -60,16 +61,41 @@ impl MicrofacetSampler {
 
     /// A reflected direction for view `wo` (wo.z > 0); it may lie below the surface.
     pub fn sample(self, g: &Ggx, wo: Vec3, u: [f32; 2]) -> Vec3 {
-        reflect(wo, self.sample_half_vector(g, wo, u))
+        to_vec3(self.sample_v(g, of_vec3(wo), u[0], u[1]))
     }
 
     /// The half vector [`Self::sample`] reflects about (h.z ≥ 0).
     pub fn sample_half_vector(self, g: &Ggx, wo: Vec3, u: [f32; 2]) -> Vec3 {
+        to_vec3(self.sample_half_vector_v(g, of_vec3(wo), u[0], u[1]))
+    }
+
+    /// [`Self::sample`] written once over lanes: the scalar sampler is this with `f32` as one
+    /// lane, so directions drawn over lanes are the scalar ones bit for bit on every ISA.
+    #[inline(always)]
+    pub fn sample_v<V: Vector<N>, const N: usize>(self, g: &Ggx, wo: V3<V>, u0: V, u1: V) -> V3<V> {
+        reflect_v(wo, self.sample_half_vector_v(g, wo, u0, u1))
+    }
+
+    /// [`Self::sample_half_vector`] over lanes (one lane: `f32`).
+    #[inline(always)]
+    pub fn sample_half_vector_v<V: Vector<N>, const N: usize>(
+        self,
+        g: &Ggx,
+        wo: V3<V>,
+        u0: V,
+        u1: V,
+    ) -> V3<V> {
         match self {
-            MicrofacetSampler::Ndf => sample_ggx_ndf(g, u),
-            MicrofacetSampler::Vndf => sample_ggx_vndf(g, wo, u),
-            MicrofacetSampler::VndfCap => sample_ggx_vndf_cap(g, wo, u),
-            MicrofacetSampler::VndfBounded => sample_ggx_vndf_bounded(g, wo, u),
+            MicrofacetSampler::Ndf => ndf_half(g, u0, u1),
+            MicrofacetSampler::Vndf => vndf_half(g, wo, u0, u1),
+            MicrofacetSampler::VndfCap => {
+                let v = normalize_v(g.stretch_v(wo));
+                cap_half(g, v, v.z, u0, u1)
+            }
+            MicrofacetSampler::VndfBounded => {
+                let v = normalize_v(g.stretch_v(wo));
+                cap_half(g, v, g.bounded_k_v(wo).mul(v.z), u0, u1)
+            }
         }
     }
 
@@ -128,6 +154,16 @@ impl Ggx {
     /// (αx ωx, αy ωy, ωz), unnormalised: a direction in the α = 1 configuration.
     pub fn stretch(&self, w: Vec3) -> Vec3 {
         Vec3::new(self.ax * w.x, self.ay * w.y, w.z)
+    }
+
+    /// [`Self::stretch`] over lanes.
+    #[inline(always)]
+    fn stretch_v<V: Vector<N>, const N: usize>(&self, w: V3<V>) -> V3<V> {
+        V3 {
+            x: V::splat(self.ax).mul(w.x),
+            y: V::splat(self.ay).mul(w.y),
+            z: w.z,
+        }
     }
 
     /// t(ω) = |(αx ωx, αy ωy, ωz)|, so that Λ(ω) = (t − |ωz|)/(2|ωz|).
@@ -197,17 +233,81 @@ impl Ggx {
 
     /// Eto & Tokuyoshi's k = (1 − a²) s² / (s² + a² wo.z²) for wo.z > 0.
     pub fn bounded_k(&self, wo: Vec3) -> f32 {
+        self.bounded_k_v(of_vec3(wo))
+    }
+
+    /// [`Self::bounded_k`] over lanes (one lane: `f32`).
+    #[inline(always)]
+    fn bounded_k_v<V: Vector<N>, const N: usize>(&self, wo: V3<V>) -> V {
         let a = self.ax.min(self.ay).min(1.0);
-        let a2 = a * a;
-        let s = 1.0 + (wo.x * wo.x + wo.y * wo.y).sqrt();
-        let s2 = s * s;
-        (1.0 - a2) * s2 / (s2 + a2 * wo.z * wo.z)
+        let a2 = V::splat(a * a);
+        let one = V::splat(1.0);
+        let s = one.add(wo.x.mul(wo.x).add(wo.y.mul(wo.y)).sqrt());
+        let s2 = s.mul(s);
+        one.sub(a2).mul(s2).div(s2.add(a2.mul(wo.z).mul(wo.z)))
     }
 }
 
 /// Mirror of `wo` about the unit normal `h`.
 pub fn reflect(wo: Vec3, h: Vec3) -> Vec3 {
     2.0 * wo.dot(h) * h - wo
+}
+
+/// [`reflect`] over lanes (one lane: `f32`), glam's operations in glam's order.
+#[inline(always)]
+fn reflect_v<V: Vector<N>, const N: usize>(wo: V3<V>, h: V3<V>) -> V3<V> {
+    let k = V::splat(2.0).mul(dot_v(wo, h));
+    V3 {
+        x: k.mul(h.x).sub(wo.x),
+        y: k.mul(h.y).sub(wo.y),
+        z: k.mul(h.z).sub(wo.z),
+    }
+}
+
+// Three-vectors over lanes of any width (one lane: `f32`), with glam's `Vec3` operations in
+// glam's order: what the samplers above are written on, once for the scalar path and the lanes.
+
+#[inline(always)]
+fn of_vec3(v: Vec3) -> V3<f32> {
+    V3 {
+        x: v.x,
+        y: v.y,
+        z: v.z,
+    }
+}
+
+#[inline(always)]
+fn to_vec3(v: V3<f32>) -> Vec3 {
+    Vec3::new(v.x, v.y, v.z)
+}
+
+#[inline(always)]
+fn dot_v<V: Vector<N>, const N: usize>(a: V3<V>, b: V3<V>) -> V {
+    a.x.mul(b.x).add(a.y.mul(b.y)).add(a.z.mul(b.z))
+}
+
+#[inline(always)]
+fn scale_v<V: Vector<N>, const N: usize>(a: V3<V>, k: V) -> V3<V> {
+    V3 {
+        x: a.x.mul(k),
+        y: a.y.mul(k),
+        z: a.z.mul(k),
+    }
+}
+
+#[inline(always)]
+fn add_v<V: Vector<N>, const N: usize>(a: V3<V>, b: V3<V>) -> V3<V> {
+    V3 {
+        x: a.x.add(b.x),
+        y: a.y.add(b.y),
+        z: a.z.add(b.z),
+    }
+}
+
+/// glam's `normalize`: times 1/|a|.
+#[inline(always)]
+fn normalize_v<V: Vector<N>, const N: usize>(a: V3<V>) -> V3<V> {
+    scale_v(a, V::splat(1.0).div(dot_v(a, a).sqrt()))
 }
 
 /// The half vector of a reflection pair, None when wi = −wo (no half vector).
@@ -221,9 +321,19 @@ pub fn half_vector(wo: Vec3, wi: Vec3) -> Option<Vec3> {
 /// has GGX's slope distribution, whose half vector is (−slope, 1) normalised (Walter et al.
 /// 2007; Heitz 2014, §5.3); the sign of the slope is immaterial by symmetry.
 pub fn sample_ggx_ndf(g: &Ggx, u: [f32; 2]) -> Vec3 {
-    let r = (u[0] / (1.0 - u[0])).sqrt();
-    let phi = 2.0 * PI * u[1];
-    Vec3::new(g.ax * r * phi.cos(), g.ay * r * phi.sin(), 1.0).normalize()
+    to_vec3(ndf_half(g, u[0], u[1]))
+}
+
+/// [`sample_ggx_ndf`] over lanes (one lane: `f32`); φ = 2π·u1 by [`cos_sin_turns`].
+#[inline(always)]
+fn ndf_half<V: Vector<N>, const N: usize>(g: &Ggx, u0: V, u1: V) -> V3<V> {
+    let r = u0.div(V::splat(1.0).sub(u0)).sqrt();
+    let (c, s) = cos_sin_turns(u1);
+    normalize_v(V3 {
+        x: V::splat(g.ax).mul(r).mul(c),
+        y: V::splat(g.ay).mul(r).mul(s),
+        z: V::splat(1.0),
+    })
 }
 
 /// Inverse of [`sample_ggx_ndf`] for h.z > 0.
@@ -247,35 +357,84 @@ pub fn ggx_ndf_pdf(g: &Ggx, wo: Vec3, h: Vec3) -> f32 {
 /// listing 1): stretch wo to the α = 1 configuration, sample the projected hemisphere as a disk
 /// whose far half is squeezed by (1 + cos θ)/2, lift, and unstretch.
 pub fn sample_ggx_vndf(g: &Ggx, wo: Vec3, u: [f32; 2]) -> Vec3 {
-    let v = g.stretch(wo).normalize();
-    let (t1, t2) = heitz_basis(v);
-    let r = u[0].sqrt();
-    let phi = 2.0 * PI * u[1];
-    let p1 = r * phi.cos();
-    let p2 = r * phi.sin();
-    let s = 0.5 * (1.0 + v.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
-    let lift = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-    let n = p1 * t1 + p2 * t2 + lift * v;
-    unstretch_normal(g, Vec3::new(n.x, n.y, n.z.max(0.0)))
+    to_vec3(vndf_half(g, of_vec3(wo), u[0], u[1]))
+}
+
+/// [`sample_ggx_vndf`] over lanes (one lane: `f32`); φ = 2π·u1 by [`cos_sin_turns`].
+#[inline(always)]
+fn vndf_half<V: Vector<N>, const N: usize>(g: &Ggx, wo: V3<V>, u0: V, u1: V) -> V3<V> {
+    let (zero, one) = (V::splat(0.0), V::splat(1.0));
+    let v = normalize_v(g.stretch_v(wo));
+    let (t1, t2) = heitz_basis_v(v);
+    let r = u0.sqrt();
+    let (c, s) = cos_sin_turns(u1);
+    let p1 = r.mul(c);
+    let p2 = r.mul(s);
+    let h = V::splat(0.5).mul(one.add(v.z));
+    let p2 = one
+        .sub(h)
+        .mul(one.sub(p1.mul(p1)).max(zero).sqrt())
+        .add(h.mul(p2));
+    let lift = one.sub(p1.mul(p1)).sub(p2.mul(p2)).max(zero).sqrt();
+    let n = add_v(add_v(scale_v(t1, p1), scale_v(t2, p2)), scale_v(v, lift));
+    unstretch_normal_v(
+        g,
+        V3 {
+            x: n.x,
+            y: n.y,
+            z: n.z.max(zero),
+        },
+    )
 }
 
 /// Heitz's orthonormal basis (T1, T2) orthogonal to the stretched view `v`.
 fn heitz_basis(v: Vec3) -> (Vec3, Vec3) {
-    let len2 = v.x * v.x + v.y * v.y;
-    let t1 = if len2 > 0.0 {
-        Vec3::new(-v.y, v.x, 0.0) / len2.sqrt()
-    } else {
-        Vec3::X
+    let (t1, t2) = heitz_basis_v(of_vec3(v));
+    (to_vec3(t1), to_vec3(t2))
+}
+
+/// [`heitz_basis`] over lanes: T1 = (−v.y, v.x, 0)/|v.xy|, +x where v is the normal.
+#[inline(always)]
+fn heitz_basis_v<V: Vector<N>, const N: usize>(v: V3<V>) -> (V3<V>, V3<V>) {
+    let zero = V::splat(0.0);
+    let len2 = v.x.mul(v.x).add(v.y.mul(v.y));
+    let tilted = zero.lt(len2);
+    let len = V::select(tilted, len2, V::splat(1.0)).sqrt();
+    let t1 = V3 {
+        x: V::select(tilted, v.y.neg().div(len), V::splat(1.0)),
+        y: V::select(tilted, v.x.div(len), zero),
+        z: zero,
     };
-    (t1, v.cross(t1))
+    // glam's cross, component by component.
+    let t2 = V3 {
+        x: v.y.mul(t1.z).sub(t1.y.mul(v.z)),
+        y: v.z.mul(t1.x).sub(t1.z.mul(v.x)),
+        z: v.x.mul(t1.y).sub(t1.x.mul(v.y)),
+    };
+    (t1, t2)
 }
 
 /// A normal of the α = 1 configuration back in the α configuration: normalize(αx n.x, αy n.y,
 /// n.z). A zero vector (a measure-zero draw exactly on the rim) becomes −z, which reflects wo
 /// below the surface where every pdf here is zero.
+#[cfg(test)]
 fn unstretch_normal(g: &Ggx, n: Vec3) -> Vec3 {
-    g.stretch(n).try_normalize().unwrap_or(Vec3::NEG_Z)
+    to_vec3(unstretch_normal_v(g, of_vec3(n)))
+}
+
+/// [`unstretch_normal`] over lanes (one lane: `f32`).
+#[inline(always)]
+fn unstretch_normal_v<V: Vector<N>, const N: usize>(g: &Ggx, n: V3<V>) -> V3<V> {
+    // glam's try_normalize: 1/|m| finite and positive, else the fallback.
+    let m = g.stretch_v(n);
+    let rcp = V::splat(1.0).div(dot_v(m, m).sqrt());
+    let ok = rcp.lt(V::splat(f32::INFINITY)) & V::splat(0.0).lt(rcp);
+    let zero = V::splat(0.0);
+    V3 {
+        x: V::select(ok, m.x.mul(rcp), zero),
+        y: V::select(ok, m.y.mul(rcp), zero),
+        z: V::select(ok, m.z.mul(rcp), V::splat(-1.0)),
+    }
 }
 
 /// The α = 1 configuration of a half vector: normalize(hx/αx, hy/αy, hz).
@@ -305,27 +464,35 @@ pub fn ggx_vndf_pdf(g: &Ggx, wo: Vec3, h: Vec3) -> f32 {
 /// HPG): in the α = 1 configuration the visible normals of ŵo are ŵo + c with c uniform on the
 /// cap z ≥ −ŵo.z of the unit sphere; unstretch.
 pub fn sample_ggx_vndf_cap(g: &Ggx, wo: Vec3, u: [f32; 2]) -> Vec3 {
-    let v = g.stretch(wo).normalize();
-    sample_cap(g, v, v.z, u)
+    MicrofacetSampler::VndfCap.sample_half_vector(g, wo, u)
 }
 
 /// Bounded visible normal by Eto & Tokuyoshi 2023 ("Bounded VNDF Sampling for Smith–GGX
 /// Reflections", SIGGRAPH Asia TC): the cap of [`sample_ggx_vndf_cap`] cut at z ≥ −k·ŵo.z,
 /// where the dropped band holds only half vectors that reflect wo below the surface.
 pub fn sample_ggx_vndf_bounded(g: &Ggx, wo: Vec3, u: [f32; 2]) -> Vec3 {
-    let v = g.stretch(wo).normalize();
-    sample_cap(g, v, g.bounded_k(wo) * v.z, u)
+    MicrofacetSampler::VndfBounded.sample_half_vector(g, wo, u)
 }
 
-/// ŵo + c with c uniform on the spherical cap z ≥ −b, unstretched. With 1 − z = u·(1 + b),
-/// sin²θ = (1 − z)(1 + z) has no cancellation near the pole.
-fn sample_cap(g: &Ggx, v: Vec3, b: f32, u: [f32; 2]) -> Vec3 {
-    let phi = 2.0 * PI * u[0];
-    let one_minus_z = u[1] * (1.0 + b);
-    let z = 1.0 - one_minus_z;
-    let sin = (one_minus_z * (2.0 - one_minus_z)).max(0.0).sqrt();
-    let c = Vec3::new(sin * phi.cos(), sin * phi.sin(), z);
-    unstretch_normal(g, c + v)
+/// ŵo + c with c uniform on the spherical cap z ≥ −b, unstretched, over lanes (one lane:
+/// `f32`); φ = 2π·u0 by [`cos_sin_turns`]. With 1 − z = u1·(1 + b), sin²θ = (1 − z)(1 + z)
+/// has no cancellation near the pole.
+#[inline(always)]
+fn cap_half<V: Vector<N>, const N: usize>(g: &Ggx, v: V3<V>, b: V, u0: V, u1: V) -> V3<V> {
+    let one = V::splat(1.0);
+    let (c, s) = cos_sin_turns(u0);
+    let one_minus_z = u1.mul(one.add(b));
+    let z = one.sub(one_minus_z);
+    let sin = one_minus_z
+        .mul(V::splat(2.0).sub(one_minus_z))
+        .max(V::splat(0.0))
+        .sqrt();
+    let point = V3 {
+        x: sin.mul(c),
+        y: sin.mul(s),
+        z,
+    };
+    unstretch_normal_v(g, add_v(point, v))
 }
 
 /// The cap point a half vector comes from: c = reflect(ŵo, ĥ) in the α = 1 configuration

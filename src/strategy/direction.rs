@@ -8,7 +8,9 @@ use super::{
     Strategy,
 };
 use crate::bsdf::lambert::diffuse_lanes;
-use crate::bsdf::{BsdfSampling, CosineLanes, CosineQuery, sample_cosine_lanes};
+use crate::bsdf::{
+    BsdfSampling, CosineLanes, CosineQuery, FrameRows, directions_to_world, sample_cosine_lanes,
+};
 use crate::geometry::Ray;
 use crate::prepare::SceneView;
 use crate::sampling::warp::{
@@ -206,7 +208,8 @@ fn cosine_query(packet: &ShadingPacket, u: [&[f32; WIDTH]; 2]) -> CosineQuery {
 /// The emission probe of `sp.bsdf.sample(u.get_3d(), sampling)` for each lane of a packet,
 /// bit for bit, written into `out` (the probes of [`emission_probe_with`]): lanes whose
 /// material is cosine-sampled draw their directions over lanes ([`sample_cosine_lanes`]: the
-/// lobe drawn by u[2] does not change the direction), the others one by one. Diffuse lanes
+/// lobe drawn by u[2] does not change the direction), the others over lanes once per material
+/// (`Bsdf::sample_local_lanes`). Diffuse lanes
 /// (a material of one built-in Lambert lobe) finish over lanes too, f = kd/π and pdf = cos/π
 /// with the scalar path's operations ([`DiffuseProbes`]); the others evaluate f and the
 /// mixture pdf over lanes, once per material ([`probe_lanes`]).
@@ -221,8 +224,6 @@ pub fn bsdf_emission_packet(
     let [u0, u1, u2] = u.take::<3>();
     let (mut cosine, mut diffuse, mut other) = (0u32, 0u32, 0u32);
     let mut kd = Soa3::default();
-    // The other lanes' directions, sampled lane by lane; f of all of them over lanes below.
-    let (mut wi, mut local) = (Soa3::default(), Soa3::default());
     let mut rest = packet.mask;
     while rest != 0 {
         let lane = rest.trailing_zeros() as usize;
@@ -235,14 +236,26 @@ pub fn bsdf_emission_packet(
             kd.set(lane, k);
         } else if bsdf.is_cosine_sampled() {
             cosine |= 1 << lane;
-        } else if let Some(bsdf) = packet.local_bsdf(lane) {
+        } else {
             other |= 1 << lane;
-            let (w, l) = bsdf.sample_direction([u0[lane], u1[lane], u2[lane]], sampling);
-            wi.set(lane, w);
-            local.set(lane, l);
         }
     }
-    probe_lanes(isa, packet, other, (&wi, &local), sampling, out);
+    if other != 0 {
+        // The other lanes' directions over lanes, once per material, then f and the pdf.
+        let geo = &packet.geo;
+        let (mut sampled, mut wi, mut local) = (Soa3::default(), Soa3::default(), Soa3::default());
+        packet.each_material(other, |bsdf, lanes| {
+            let u = [u0, u1, u2];
+            bsdf.sample_local_lanes(isa, &geo.wo_local, u, sampling, lanes, &mut sampled);
+        });
+        let frames = FrameRows {
+            s: &geo.s,
+            t: &geo.t,
+            n: &geo.n,
+        };
+        directions_to_world(isa, frames, &sampled, other, (&mut wi, &mut local));
+        probe_lanes(isa, packet, other, (&wi, &local), sampling, out);
+    }
     if cosine | diffuse == 0 {
         return;
     }
@@ -264,7 +277,7 @@ pub fn bsdf_emission_packet(
 
 /// The emission probes of the lanes of `mask` from their sampled directions (`wi` in the
 /// world, `local` in the shading frame, as `LocalBsdf::sample` rounds them): f and the
-/// mixture pdf over lanes once per material, then [`emission_probe_lane`] per lane.
+/// mixture pdf over lanes once per material, then the probes over lanes ([`EmissionProbes`]).
 #[inline(always)]
 fn probe_lanes(
     isa: Isa,
@@ -283,19 +296,41 @@ fn probe_lanes(
         bsdf.eval_lanes(isa, wo, local, lanes, &mut f);
         bsdf.pdf_lanes(isa, wo, local, sampling, lanes, &mut pdf);
     });
-    let mut rest = mask & packet.mask;
-    while rest != 0 {
-        let lane = rest.trailing_zeros() as usize;
-        rest &= rest - 1;
-        let e = emission_probe_lane(packet, lane, wi.get(lane), f.get(lane), pdf[lane]).emission;
-        out.set_emission(lane, e);
+    simd::run(
+        isa,
+        EmissionProbes {
+            wi,
+            f: &f,
+            pdf: &pdf,
+            geo: &packet.geo,
+            mask: mask & packet.mask,
+            out,
+        },
+    );
+}
+
+/// The emission probes of the lanes of `mask` for directions `wi` with f and pdf known, over
+/// lanes ([`store_emission_probes`]).
+struct EmissionProbes<'a> {
+    wi: &'a Soa3,
+    f: &'a Soa3,
+    pdf: &'a [f32; WIDTH],
+    geo: &'a ShadingLanes,
+    mask: u32,
+    out: &'a mut ProbePacket,
+}
+
+impl simd::Kernel for EmissionProbes<'_> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let (wi, f, pdf) = (V3::load(self.wi), V3::load(self.f), L::V::load(self.pdf));
+        store_emission_probes(self.geo, self.mask, wi, f, pdf, self.out);
     }
 }
 
 /// The emission probes of diffuse lanes `mask` over lanes: f and the pdf by
-/// [`diffuse_lanes`], then [`emission_probe_from`] (no probe where n·wi ≤ 0 or pdf ≤ 0, else
-/// weight f·(n·wi/pdf)), each with the scalar operations in their order, so every lane is its
-/// scalar probe bit for bit.
+/// [`diffuse_lanes`], then [`store_emission_probes`].
 struct DiffuseProbes<'a> {
     r: &'a CosineLanes,
     kd: &'a Soa3,
@@ -308,52 +343,48 @@ impl simd::Kernel for DiffuseProbes<'_> {
     type Out = ();
     #[inline(always)]
     fn run<L: Lanes>(self) {
-        let zero = L::V::splat(0.0);
         let (wi, local) = (
             V3::<L::V>::load(&self.r.wi),
             V3::<L::V>::load(&self.r.local),
         );
         let (f, pdf) = diffuse_lanes(V3::load(self.kd), local.z);
-        let cos = V3::<L::V>::load(&self.geo.n).dot(wi);
-        let ok = self.mask & !cos.le(zero) & !pdf.le(zero);
-        let weight = f.scale(cos.div(pdf));
-        let out = self.out;
-        let e = &mut out.emission;
-        let origin = V3::<L::V>::load(&self.geo.origin);
-        let rows: [(&mut [f32; WIDTH], L::V); 7] = [
-            (&mut e.ox, origin.x),
-            (&mut e.oy, origin.y),
-            (&mut e.oz, origin.z),
-            (&mut e.dx, wi.x),
-            (&mut e.dy, wi.y),
-            (&mut e.dz, wi.z),
-            (&mut e.tmax, L::V::splat(f32::INFINITY)),
-        ];
-        for (row, v) in rows {
-            L::V::select(ok, v, L::V::load(row)).store(row);
-        }
-        V3::select(ok, weight, V3::load(&out.emission_weight)).store(&mut out.emission_weight);
-        L::V::select(ok, pdf, L::V::load(&out.emission_pdf)).store(&mut out.emission_pdf);
-        out.emission_mask = (out.emission_mask & !self.mask) | ok;
+        store_emission_probes(self.geo, self.mask, wi, f, pdf, self.out);
     }
 }
 
-/// [`emission_probe_with`] for lane `lane` of `packet`, from its lanes (no point is built).
+/// [`emission_probe_from`] for the lanes of `mask`, each scalar operation in its order (no
+/// probe where n·wi ≤ 0 or pdf ≤ 0, else the ray from the point's origin along wi with weight
+/// f·(n·wi/pdf)), so every lane is its scalar probe bit for bit; other lanes kept.
 #[inline(always)]
-pub fn emission_probe_lane(
-    packet: &ShadingPacket,
-    lane: usize,
-    wi: glam::Vec3,
-    f: glam::Vec3,
-    pdf: f32,
-) -> Probes {
-    emission_probe_from(
-        packet.geo.origin.get(lane),
-        packet.geo.n.get(lane),
-        wi,
-        f,
-        pdf,
-    )
+fn store_emission_probes<V: Vector<WIDTH>>(
+    geo: &ShadingLanes,
+    mask: u32,
+    wi: V3<V>,
+    f: V3<V>,
+    pdf: V,
+    out: &mut ProbePacket,
+) {
+    let zero = V::splat(0.0);
+    let cos = V3::<V>::load(&geo.n).dot(wi);
+    let ok = mask & !cos.le(zero) & !pdf.le(zero);
+    let weight = f.scale(cos.div(pdf));
+    let e = &mut out.emission;
+    let origin = V3::<V>::load(&geo.origin);
+    let rows: [(&mut [f32; WIDTH], V); 7] = [
+        (&mut e.ox, origin.x),
+        (&mut e.oy, origin.y),
+        (&mut e.oz, origin.z),
+        (&mut e.dx, wi.x),
+        (&mut e.dy, wi.y),
+        (&mut e.dz, wi.z),
+        (&mut e.tmax, V::splat(f32::INFINITY)),
+    ];
+    for (row, v) in rows {
+        V::select(ok, v, V::load(row)).store(row);
+    }
+    V3::select(ok, weight, V3::load(&out.emission_weight)).store(&mut out.emission_weight);
+    V::select(ok, pdf, V::load(&out.emission_pdf)).store(&mut out.emission_pdf);
+    out.emission_mask = (out.emission_mask & !mask) | ok;
 }
 
 /// The emission probe for a direction sampled with solid-angle pdf `pdf`; nothing for
