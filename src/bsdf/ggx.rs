@@ -104,7 +104,7 @@ impl EvalLanes for GgxLobe {
     }
 
     /// [`Lobe::pdf`]: [`MicrofacetSampler::pdf`] for wo.z > 0, the half vector taken on the
-    /// upper side; the bounded sampler's cap test stays lane by lane.
+    /// upper side.
     #[inline(always)]
     fn pdf_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>, sampler: MicrofacetSampler) -> V {
         let zero = V::splat(0.0);
@@ -119,19 +119,24 @@ impl EvalLanes for GgxLobe {
                 let c = V::select(nonzero, c, V::splat(1.0));
                 (g.d_lanes(h).mul(h.z).div(V::splat(4.0).mul(c)), nonzero)
             }
-            _ => {
+            MicrofacetSampler::Vndf | MicrofacetSampler::VndfCap => {
                 // ggx_cap_pdf with k = 1: 0.5·d(h)/(k·wo.z + t(wo)), 0 unless wo.z, h.z and
                 // wo·h are all positive.
                 let valid = !wo.z.le(zero) & !h.z.le(zero) & !wo.dot(h).le(zero);
                 let denom = V::splat(1.0).mul(wo.z).add(g.stretched_len_lanes(wo));
                 (V::splat(0.5).mul(g.d_lanes(h)).div(denom), valid)
             }
+            MicrofacetSampler::VndfBounded => {
+                // ggx_cap_pdf with Eto & Tokuyoshi's k < 1: also 0 where h's cap point lies in
+                // the dropped band.
+                let k = g.bounded_k_v(wo);
+                let mut valid = !wo.z.le(zero) & !h.z.le(zero) & !wo.dot(h).le(zero);
+                valid &= !(k.lt(V::splat(1.0)) & g.below_cap_v(wo, h, k));
+                let denom = k.mul(wo.z).add(g.stretched_len_lanes(wo));
+                (V::splat(0.5).mul(g.d_lanes(h)).div(denom), valid)
+            }
         };
         V::select(ok & valid, pdf, zero)
-    }
-
-    fn pdf_over_lanes(&self, sampler: MicrofacetSampler) -> bool {
-        sampler != MicrofacetSampler::VndfBounded
     }
 
     /// [`Lobe::sample`]: the sampler's own code over lanes; lanes seen edge-on (wo.z ≤ 0)

@@ -124,12 +124,8 @@ pub trait Lobe: Send + Sync + std::fmt::Debug {
 /// stand-ins and return 0, as the scalar test does.
 pub(crate) trait EvalLanes: Sync {
     fn eval_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>) -> V3<V>;
-    /// [`Lobe::pdf`] over lanes, for the samplers [`Self::pdf_over_lanes`] covers.
+    /// [`Lobe::pdf`] over lanes.
     fn pdf_v<V: Vector<WIDTH>>(&self, wo: V3<V>, wi: V3<V>, sampler: MicrofacetSampler) -> V;
-    /// Whether [`Self::pdf_v`] covers `sampler`.
-    fn pdf_over_lanes(&self, _sampler: MicrofacetSampler) -> bool {
-        true
-    }
     /// [`Lobe::sample`] over lanes, written on the scalar sampler's own lane code.
     fn sample_v<V: Vector<WIDTH>>(&self, wo: V3<V>, u: [V; 2], sampler: MicrofacetSampler)
     -> V3<V>;
@@ -163,19 +159,14 @@ fn add_pdf_lane_by_lane<L: Lobe + ?Sized>(lobe: &L, q: &PdfQuery, p: f32, acc: &
     }
 }
 
-/// [`Lobe::add_pdf_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa` where
-/// it covers the sampler, else the lane-by-lane default.
-pub(crate) fn add_pdf_lanes<E: EvalLanes + Lobe>(
+/// [`Lobe::add_pdf_lanes`] of a lobe with [`EvalLanes`]: one pass over lanes on `isa`.
+pub(crate) fn add_pdf_lanes<E: EvalLanes>(
     lobe: &E,
     isa: Isa,
     q: &PdfQuery,
     p: f32,
     acc: &mut [f32; WIDTH],
 ) {
-    if !lobe.pdf_over_lanes(q.sampler) {
-        add_pdf_lane_by_lane(lobe, q, p, acc);
-        return;
-    }
     struct Kernel<'a, E> {
         lobe: &'a E,
         q: &'a PdfQuery<'a>,

@@ -236,9 +236,30 @@ impl Ggx {
         self.bounded_k_v(of_vec3(wo))
     }
 
+    /// The lanes whose half vector `h` comes from a point below the cap z ≥ −k·ŵo.z (in the
+    /// band the bounded sampler drops), over lanes (one lane: `f32`): [`cap_point`]'s z
+    /// against the floor.
+    #[inline(always)]
+    pub(crate) fn below_cap_v<V: Vector<N>, const N: usize>(
+        &self,
+        wo: V3<V>,
+        h: V3<V>,
+        k: V,
+    ) -> u32 {
+        let v = normalize_v(self.stretch_v(wo));
+        let n = normalize_v(V3 {
+            x: h.x.div(V::splat(self.ax)),
+            y: h.y.div(V::splat(self.ay)),
+            z: h.z,
+        });
+        // cap_point(v, h).z = (2 n·v)·n.z − v.z.
+        let cz = V::splat(2.0).mul(dot_v(n, v)).mul(n.z).sub(v.z);
+        cz.lt(k.neg().mul(v.z))
+    }
+
     /// [`Self::bounded_k`] over lanes (one lane: `f32`).
     #[inline(always)]
-    fn bounded_k_v<V: Vector<N>, const N: usize>(&self, wo: V3<V>) -> V {
+    pub(crate) fn bounded_k_v<V: Vector<N>, const N: usize>(&self, wo: V3<V>) -> V {
         let a = self.ax.min(self.ay).min(1.0);
         let a2 = V::splat(a * a);
         let one = V::splat(1.0);
@@ -522,11 +543,8 @@ fn ggx_cap_pdf(g: &Ggx, wo: Vec3, h: Vec3, k: f32) -> f32 {
     if wo.z <= 0.0 || h.z <= 0.0 || wo.dot(h) <= 0.0 {
         return 0.0;
     }
-    if k < 1.0 {
-        let v = g.stretch(wo).normalize();
-        if cap_point(g, v, h).z < -k * v.z {
-            return 0.0;
-        }
+    if k < 1.0 && g.below_cap_v(of_vec3(wo), of_vec3(h), k) != 0 {
+        return 0.0;
     }
     0.5 * g.d(h) / (k * wo.z + g.stretched_len(wo))
 }
