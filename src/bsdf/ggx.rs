@@ -119,19 +119,19 @@ impl EvalLanes for GgxLobe {
                 let c = V::select(nonzero, c, V::splat(1.0));
                 (g.d_lanes(h).mul(h.z).div(V::splat(4.0).mul(c)), nonzero)
             }
-            MicrofacetSampler::Vndf | MicrofacetSampler::VndfCap => {
-                // ggx_cap_pdf with k = 1: 0.5·d(h)/(k·wo.z + t(wo)), 0 unless wo.z, h.z and
-                // wo·h are all positive.
-                let valid = !wo.z.le(zero) & !h.z.le(zero) & !wo.dot(h).le(zero);
-                let denom = V::splat(1.0).mul(wo.z).add(g.stretched_len_lanes(wo));
-                (V::splat(0.5).mul(g.d_lanes(h)).div(denom), valid)
-            }
-            MicrofacetSampler::VndfBounded => {
-                // ggx_cap_pdf with Eto & Tokuyoshi's k < 1: also 0 where h's cap point lies in
-                // the dropped band.
-                let k = g.bounded_k_v(wo);
+            _ => {
+                // ggx_cap_pdf: 0.5·d(h)/(k·wo.z + t(wo)), 0 unless wo.z, h.z and wo·h are all
+                // positive; k = 1 but for the bounded sampler, whose k < 1 also zeroes the
+                // half vectors whose cap point lies in the dropped band.
+                let one = V::splat(1.0);
                 let mut valid = !wo.z.le(zero) & !h.z.le(zero) & !wo.dot(h).le(zero);
-                valid &= !(k.lt(V::splat(1.0)) & g.below_cap_v(wo, h, k));
+                let k = if sampler == MicrofacetSampler::VndfBounded {
+                    let k = g.bounded_k_v(wo);
+                    valid &= !(k.lt(one) & g.below_cap_v(wo, h, k));
+                    k
+                } else {
+                    one
+                };
                 let denom = k.mul(wo.z).add(g.stretched_len_lanes(wo));
                 (V::splat(0.5).mul(g.d_lanes(h)).div(denom), valid)
             }

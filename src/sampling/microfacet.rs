@@ -247,14 +247,7 @@ impl Ggx {
         k: V,
     ) -> u32 {
         let v = normalize_v(self.stretch_v(wo));
-        let n = normalize_v(V3 {
-            x: h.x.div(V::splat(self.ax)),
-            y: h.y.div(V::splat(self.ay)),
-            z: h.z,
-        });
-        // cap_point(v, h).z = (2 n·v)·n.z − v.z.
-        let cz = V::splat(2.0).mul(dot_v(n, v)).mul(n.z).sub(v.z);
-        cz.lt(k.neg().mul(v.z))
+        cap_point_v(self, v, h).z.lt(k.neg().mul(v.z))
     }
 
     /// [`Self::bounded_k`] over lanes (one lane: `f32`).
@@ -460,7 +453,17 @@ fn unstretch_normal_v<V: Vector<N>, const N: usize>(g: &Ggx, n: V3<V>) -> V3<V> 
 
 /// The α = 1 configuration of a half vector: normalize(hx/αx, hy/αy, hz).
 fn stretched_normal(g: &Ggx, h: Vec3) -> Vec3 {
-    Vec3::new(h.x / g.ax, h.y / g.ay, h.z).normalize()
+    to_vec3(stretched_normal_v(g, of_vec3(h)))
+}
+
+/// [`stretched_normal`] over lanes (one lane: `f32`).
+#[inline(always)]
+fn stretched_normal_v<V: Vector<N>, const N: usize>(g: &Ggx, h: V3<V>) -> V3<V> {
+    normalize_v(V3 {
+        x: h.x.div(V::splat(g.ax)),
+        y: h.y.div(V::splat(g.ay)),
+        z: h.z,
+    })
 }
 
 /// Inverse of [`sample_ggx_vndf`] for h.z > 0 and wo·h > 0.
@@ -519,8 +522,13 @@ fn cap_half<V: Vector<N>, const N: usize>(g: &Ggx, v: V3<V>, b: V, u0: V, u1: V)
 /// The cap point a half vector comes from: c = reflect(ŵo, ĥ) in the α = 1 configuration
 /// (|λĥ − ŵo| = 1 gives λ = 2 ĥ·ŵo).
 fn cap_point(g: &Ggx, v: Vec3, h: Vec3) -> Vec3 {
-    let n = stretched_normal(g, h);
-    2.0 * n.dot(v) * n - v
+    to_vec3(cap_point_v(g, of_vec3(v), of_vec3(h)))
+}
+
+/// [`cap_point`] over lanes (one lane: `f32`): the reflection of ŵo about ĥ.
+#[inline(always)]
+fn cap_point_v<V: Vector<N>, const N: usize>(g: &Ggx, v: V3<V>, h: V3<V>) -> V3<V> {
+    reflect_v(v, stretched_normal_v(g, h))
 }
 
 /// Inverse of the cap samplers for the cap z ≥ −b.
