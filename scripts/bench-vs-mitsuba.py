@@ -202,6 +202,21 @@ def image_diffs(np, a, b, block=8):
     return mean_rel, rel(a), rel(a[:, ::-1])
 
 
+def cpu_description():
+    """The first processor's name, family, model and stepping (as dibench's run metadata
+    records them): a VM's bare "AMD EPYC" covers Zen 2 to Zen 5, whose timings differ 2x."""
+    try:
+        first = open("/proc/cpuinfo").read().split("\n\n")[0]
+    except OSError:
+        return "unknown"
+    f = dict((k.strip(), v.strip()) for k, _, v in (l.partition(":") for l in first.splitlines()))
+    ids = [f"{label} {f[key]}" for label, key in
+           (("family", "cpu family"), ("model", "model"), ("stepping", "stepping")) if key in f]
+    flags = f.get("flags", "").split()
+    isa = "avx512" if "avx512f" in flags else "avx2" if "avx2" in flags else "no avx2"
+    return f"{f.get('model name', 'unknown')} ({', '.join(ids + [isa])})"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenes", default="cornell,bunny,sphere_light,mesh_light,env_venice_bunny")
@@ -213,6 +228,7 @@ def main():
                     "in every round beside --dibench, the two in alternating order")
     ap.add_argument("--out", type=Path, help="output directory (default: a new temporary one)")
     args = ap.parse_args()
+    print(f"cpu: {cpu_description()}", flush=True)
     out = (args.out or Path(tempfile.mkdtemp(prefix="bench-vs-mitsuba-"))).resolve()
     out.mkdir(parents=True, exist_ok=True)
     exe = str(Path(args.dibench).resolve())

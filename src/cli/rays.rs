@@ -96,6 +96,7 @@ pub fn run(a: RaysArgs) -> Result<()> {
         packing: a.packets,
         rows,
         csv: path,
+        cpu: crate::harness::cpu_model(),
     };
     print!("{report}");
     Ok(())

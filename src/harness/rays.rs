@@ -204,6 +204,8 @@ pub struct RaysReport {
     pub packing: Packing,
     pub rows: Vec<RaysRow>,
     pub csv: PathBuf,
+    /// The machine, as [`super::cpu_model`] describes it: figures name it.
+    pub cpu: String,
 }
 
 /// The table `dibench rays` prints, with our best packet path against Embree's best kernel
@@ -213,7 +215,7 @@ impl std::fmt::Display for RaysReport {
         let rows = &self.rows;
         writeln!(
             f,
-            "scene {} · {} threads · {}x{} rays per class, packets of {} · best of {} rounds",
+            "scene {} · {} threads · {}x{} rays per class, packets of {} · best of {} rounds\ncpu {}",
             self.scene,
             self.threads,
             self.size,
@@ -222,7 +224,8 @@ impl std::fmt::Display for RaysReport {
                 Packing::Tile => "4x4 pixels",
                 Packing::Pixel => "one pixel's 16 samples",
             },
-            self.rounds
+            self.rounds,
+            self.cpu
         )?;
         writeln!(
             f,
