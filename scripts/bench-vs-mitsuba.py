@@ -214,7 +214,7 @@ def cpu_description():
            (("family", "cpu family"), ("model", "model"), ("stepping", "stepping")) if key in f]
     flags = f.get("flags", "").split()
     isa = "avx512" if "avx512f" in flags else "avx2" if "avx2" in flags else "no avx2"
-    return f"{f.get('model name', 'unknown')} ({', '.join(ids + [isa])})"
+    return f"{f.get('model name', 'unknown')} ({', '.join(ids)}; {isa})"
 
 
 def main():
