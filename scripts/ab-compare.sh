@@ -19,6 +19,7 @@ if [[ ${#CASES[@]} -eq 0 ]]; then
 fi
 cd "$(dirname "$0")/.."
 source scripts/compare-rows.sh
+cpu_line
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 for r in $(seq 1 "$ROUNDS"); do
