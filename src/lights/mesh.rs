@@ -20,7 +20,7 @@ use crate::sampling::spherical::{
     MIN_SOLID_ANGLE, SphericalTriangle, triangle_solid_angle, triangle_solid_angle_lanes,
 };
 use crate::sampling::warp::{sample_uniform_triangle, uniform_triangle};
-use crate::simd::{self, Isa, Lanes, Soa3, V3, Vector, Vector64, WIDTH, dot3, normalize3, scale3};
+use crate::simd::{self, Isa, Lanes, V3, Vector, Vector64, WIDTH, dot3, normalize3, scale3};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug)]
@@ -259,12 +259,14 @@ fn area_lanes<V: Vector<WIDTH>>(r: &LaneRecords, q: &LaneQuery, a: u32, out: &mu
     let zero = V::splat(0.0);
     let valid = a & zero.lt(d2) & !cos_l.le(zero);
     let pdf = d2.div(V::load(&r[12]).mul(cos_l));
-    let keep = |new: V3<V>, old: &mut Soa3| V3::select(a, new, V3::load(old)).store(old);
-    keep(wi, &mut out.wi);
-    keep(point, &mut out.point);
-    keep(normal, &mut out.normal);
-    keep(error, &mut out.point_error);
-    keep(v3(13), &mut out.radiance);
+    // `keep`, not a closure of its own: that closure, called five times, was compiled out of
+    // line, outside the kernel's target features, its vector operations left as calls
+    // (`tests/inlined.rs`).
+    keep(a, wi, &mut out.wi);
+    keep(a, point, &mut out.point);
+    keep(a, normal, &mut out.normal);
+    keep(a, error, &mut out.point_error);
+    keep(a, v3(13), &mut out.radiance);
     V::select(a, pdf, V::load(&out.pdf)).store(&mut out.pdf);
     out.valid = (out.valid & !a) | valid;
     out.distant &= !a;
