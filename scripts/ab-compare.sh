@@ -19,7 +19,7 @@ if [[ ${#CASES[@]} -eq 0 ]]; then
 fi
 cd "$(dirname "$0")/.."
 source scripts/compare-rows.sh
-cpu_line
+cpu_line "$B"
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 for r in $(seq 1 "$ROUNDS"); do

@@ -39,6 +39,7 @@ via HOME, the CSV) stays under --out.
 """
 import argparse
 import csv
+import json
 import math
 import os
 import statistics
@@ -172,7 +173,8 @@ def time_mitsuba(mi, dr, scene, spp, seed):
 
 
 def run_dibench(exe, scene, strategies, seconds, out):
-    """{strategy: (spp per second, its EXR)} from one `compare` run, at its last checkpoint."""
+    """{strategy: (spp per second, its EXR)} from one `compare` run, at its last checkpoint, and
+    the machine as the run's metadata names it (`cpu_model`: name, family, model, stepping, ISA)."""
     r = subprocess.run([exe, "compare", scene, "--strategies", ",".join(strategies), "--threads", "1",
                         "--time", str(seconds), "--reference-spp", "16", "--out", str(out)],
                        capture_output=True, text=True)
@@ -184,7 +186,9 @@ def run_dibench(exe, scene, strategies, seconds, out):
     with open(run / "results.csv") as f:
         for row in csv.DictReader(f):
             last[row["strategy"]] = row  # rows are in checkpoint order: the last one wins
-    return {s: (int(last[s]["spp"]) / float(last[s]["time_s"]), run / f"{s}.exr") for s in strategies}
+    rates = {s: (int(last[s]["spp"]) / float(last[s]["time_s"]), run / f"{s}.exr") for s in strategies}
+    with open(run / "run.json") as f:
+        return rates, json.load(f)["cpu_model"]
 
 
 def image_diffs(np, a, b, block=8):
@@ -202,21 +206,6 @@ def image_diffs(np, a, b, block=8):
     return mean_rel, rel(a), rel(a[:, ::-1])
 
 
-def cpu_description():
-    """The first processor's name, family, model and stepping (as dibench's run metadata
-    records them): a VM's bare "AMD EPYC" covers Zen 2 to Zen 5, whose timings differ 2x."""
-    try:
-        first = open("/proc/cpuinfo").read().split("\n\n")[0]
-    except OSError:
-        return "unknown"
-    f = dict((k.strip(), v.strip()) for k, _, v in (l.partition(":") for l in first.splitlines()))
-    ids = [f"{label} {f[key]}" for label, key in
-           (("family", "cpu family"), ("model", "model"), ("stepping", "stepping")) if key in f]
-    flags = f.get("flags", "").split()
-    isa = "avx512" if "avx512f" in flags else "avx2" if "avx2" in flags else "no avx2"
-    return f"{f.get('model name', 'unknown')} ({', '.join(ids)}; {isa})"
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scenes", default="cornell,bunny,sphere_light,mesh_light,env_venice_bunny")
@@ -228,7 +217,6 @@ def main():
                     "in every round beside --dibench, the two in alternating order")
     ap.add_argument("--out", type=Path, help="output directory (default: a new temporary one)")
     args = ap.parse_args()
-    print(f"cpu: {cpu_description()}", flush=True)
     out = (args.out or Path(tempfile.mkdtemp(prefix="bench-vs-mitsuba-"))).resolve()
     out.mkdir(parents=True, exist_ok=True)
     exe = str(Path(args.dibench).resolve())
@@ -252,6 +240,7 @@ def main():
             scene = mi.load_dict(d)
             time_mitsuba(mi, dr, scene, args.spp, 0)  # JIT compilation, untimed
             scenes[name, est] = (scene, w * h, strat)
+    first_scene = args.scenes.split(",")[0]
     for r in range(1, args.rounds + 1):
         for name in args.scenes.split(","):
             for est in ESTIMATORS:
@@ -262,7 +251,9 @@ def main():
             strats = [scenes[name, est][2] for est in ESTIMATORS]
             order = [(exe, dib_t, "dibench")] + ([(base_exe, base_t, "baseline")] if base_exe else [])
             for binary, times, tag in (order if r % 2 else order[::-1]):
-                got = run_dibench(binary, name, strats, args.time, out / f"{tag}-round{r}")
+                got, machine = run_dibench(binary, name, strats, args.time, out / f"{tag}-round{r}")
+                if r == 1 and name == first_scene and tag == "dibench":
+                    print(f"cpu: {machine}", flush=True)  # every figure names its machine
                 for est in ESTIMATORS:
                     times.setdefault((name, est), []).append(scenes[name, est][1] * got[scenes[name, est][2]][0])
                 if tag == "dibench":

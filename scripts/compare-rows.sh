@@ -19,14 +19,17 @@ compare_rows() {
   rm -rf "$out" "$out.err"
 }
 
-# cpu_line: "cpu: NAME (family F, model M, stepping S; ISA)" from /proc/cpuinfo's first
-# processor, as dibench's run metadata and `rays` name the machine. The timing scripts print it
-# first: a VM's bare "AMD EPYC" covers Zen 2 to Zen 5, whose timings differ 2x and more.
+# cpu_line BINARY: "cpu: ..." as BINARY's run metadata names the machine (`cpu_model`: name,
+# family, model, stepping, ISA), from a one-sample compare of cornell. The timing scripts print
+# it first: a VM's bare "AMD EPYC" covers Zen 2 to Zen 5, whose timings differ 2x and more.
 cpu_line() {
-  awk -F: '/^[ \t]*$/ { exit }
-    { k = $1; sub(/[ \t]+$/, "", k); v = substr($0, index($0, ":") + 1); sub(/^[ \t]+/, "", v); f[k] = v }
-    END {
-      isa = (f["flags"] ~ /(^| )avx512f( |$)/) ? "avx512" : (f["flags"] ~ /(^| )avx2( |$)/) ? "avx2" : "no avx2"
-      printf "cpu: %s (family %s, model %s, stepping %s; %s)\n", f["model name"], f["cpu family"], f["model"], f["stepping"], isa
-    }' /proc/cpuinfo 2> /dev/null || echo "cpu: unknown"
+  local out
+  out=$(mktemp -d)
+  if "$1" compare cornell --strategies light --spp 1 --reference-spp 1 --out "$out" \
+      > /dev/null 2>&1; then
+    sed -n 's/.*"cpu_model": *"\([^"]*\)".*/cpu: \1/p' "$out"/cornell/*/run.json | head -1
+  else
+    echo "cpu: unknown (compare failed)"
+  fi
+  rm -rf "$out"
 }

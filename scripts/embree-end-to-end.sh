@@ -16,7 +16,7 @@ BIN=$(realpath "$1"); ROUNDS=${2:-2}; TIME=${3:-2}
 shift $(( $# < 3 ? $# : 3 ))
 cd "$(dirname "$0")/.."
 source scripts/compare-rows.sh
-cpu_line
+cpu_line "$BIN"
 SCENES=("$@")
 if [[ ${#SCENES[@]} -eq 0 ]]; then
   for s in scenes/*.toml; do SCENES+=("$(basename "$s" .toml)"); done

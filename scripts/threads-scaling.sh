@@ -14,7 +14,7 @@ CASES=("$@")
 [[ ${#CASES[@]} -gt 0 ]] || CASES=(cornell:light:2048 cornell:mis-power:1024)
 cd "$(dirname "$0")/.."
 source scripts/compare-rows.sh
-cpu_line
+cpu_line "$BIN"
 LOG=$(mktemp)
 trap 'rm -f "$LOG"' EXIT
 for r in $(seq 1 "$ROUNDS"); do
