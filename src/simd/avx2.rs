@@ -31,6 +31,32 @@ pub struct Y(__m256);
 #[derive(Clone, Copy)]
 pub struct Y2(Y, Y);
 
+/// `v`, unchanged, as a value LLVM cannot see into, so that a store of it stays a plain store.
+/// LLVM (22) folds `store(select(m, x, load(p)), p)`, i.e. `select(m, x, old).store(old)`,
+/// into one `vmaskmovps`, an AVX masked store that AMD runs as microcode (Zen 2 and Zen 3: 42
+/// µops, one per 12 cycles, per uops.info; Zen 4's are slow too, only its AVX-512 masked
+/// stores are fast) where a load, a blend and a store take about three µops. 8 % of a bunny
+/// `light` pass sat at such stores on a Zen 3 (docs/tracer.md, stop 54). No instruction: the
+/// register is only named in the template's comment. `tests/inlined.rs` checks that the
+/// binary has no masked store left in dibench's code.
+///
+/// # Safety
+/// The CPU must support avx (only ever inlined into an `avx2` or `avx512f` entry, like an
+/// intrinsic).
+#[target_feature(enable = "avx")]
+#[inline]
+unsafe fn opaque(mut v: __m256) -> __m256 {
+    // SAFETY: an empty template: no instruction; no memory, flags or stack touched.
+    unsafe {
+        std::arch::asm!(
+            "/* {0} */",
+            inout(ymm_reg) v,
+            options(pure, nomem, nostack, preserves_flags)
+        );
+    }
+    v
+}
+
 /// Expands 8 mask bits into all-ones / all-zeros lanes.
 #[inline(always)]
 fn expand(m: u32) -> __m256 {
@@ -70,7 +96,7 @@ impl Vector<NARROW> for Y {
     }
     #[inline(always)]
     fn store(self, a: &mut [f32; NARROW]) {
-        unsafe { _mm256_storeu_ps(a.as_mut_ptr(), self.0) }
+        unsafe { _mm256_storeu_ps(a.as_mut_ptr(), opaque(self.0)) }
     }
     op!(add, _mm256_add_ps);
     op!(sub, _mm256_sub_ps);
