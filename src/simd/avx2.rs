@@ -57,6 +57,33 @@ unsafe fn opaque(mut v: __m256) -> __m256 {
     v
 }
 
+/// Mask bits `first..first + 8` of `m` in the sign bits of lanes 0–7 (each lane's other bits
+/// are left over), which is all `blendv` reads: one variable shift of the broadcast mask per
+/// 8 lanes, where [`expand`] takes an and and a compare, and one broadcast for all of a wide
+/// vector's registers.
+#[inline(always)]
+fn sign_bits(m: __m256i, first: i32) -> __m256 {
+    unsafe {
+        let shift = _mm256_sub_epi32(
+            _mm256_set1_epi32(31 - first),
+            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+        );
+        _mm256_castsi256_ps(_mm256_sllv_epi32(m, shift))
+    }
+}
+
+/// [`sign_bits`] for 4 f64 lanes: mask bits `first..first + 4` in their sign bits.
+#[inline(always)]
+fn sign_bits64(m: __m256i, first: i64) -> __m256d {
+    unsafe {
+        let shift = _mm256_sub_epi64(
+            _mm256_set1_epi64x(63 - first),
+            _mm256_setr_epi64x(0, 1, 2, 3),
+        );
+        _mm256_castsi256_pd(_mm256_sllv_epi64(m, shift))
+    }
+}
+
 /// Expands 8 mask bits into all-ones / all-zeros lanes.
 #[inline(always)]
 fn expand(m: u32) -> __m256 {
@@ -153,7 +180,10 @@ impl Vector<NARROW> for Y {
     }
     #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
-        unsafe { Y(_mm256_blendv_ps(b.0, a.0, expand(m))) }
+        unsafe {
+            let m = sign_bits(_mm256_set1_epi32(m as i32), 0);
+            Y(_mm256_blendv_ps(b.0, a.0, m))
+        }
     }
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -268,7 +298,13 @@ impl Vector<WIDTH> for Y2 {
     }
     #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
-        Y2(Y::select(m & 0xff, a.0, b.0), Y::select(m >> 8, a.1, b.1))
+        unsafe {
+            let m = _mm256_set1_epi32(m as i32);
+            Y2(
+                Y(_mm256_blendv_ps(b.0.0, a.0.0, sign_bits(m, 0))),
+                Y(_mm256_blendv_ps(b.1.0, a.1.0, sign_bits(m, 8))),
+            )
+        }
     }
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -296,16 +332,6 @@ impl Vector<WIDTH> for Y2 {
 /// `avx2` entry.
 #[derive(Clone, Copy)]
 pub struct YD([__m256d; 4]);
-
-/// Expands 4 mask bits into all-ones / all-zeros f64 lanes.
-#[inline(always)]
-fn expand64(m: u32) -> __m256d {
-    unsafe {
-        let bit = _mm256_setr_epi64x(1, 2, 4, 8);
-        let v = _mm256_and_si256(_mm256_set1_epi64x(m as i64), bit);
-        _mm256_castsi256_pd(_mm256_cmpeq_epi64(v, bit))
-    }
-}
 
 macro_rules! op64 {
     ($name:ident, $f:ident) => {
@@ -437,11 +463,12 @@ impl Vector64<WIDTH> for YD {
     fn select(m: u32, a: Self, b: Self) -> Self {
         let (a, b) = (a.0, b.0);
         unsafe {
+            let m = _mm256_set1_epi64x(m as i64);
             YD([
-                _mm256_blendv_pd(b[0], a[0], expand64(m)),
-                _mm256_blendv_pd(b[1], a[1], expand64(m >> 4)),
-                _mm256_blendv_pd(b[2], a[2], expand64(m >> 8)),
-                _mm256_blendv_pd(b[3], a[3], expand64(m >> 12)),
+                _mm256_blendv_pd(b[0], a[0], sign_bits64(m, 0)),
+                _mm256_blendv_pd(b[1], a[1], sign_bits64(m, 4)),
+                _mm256_blendv_pd(b[2], a[2], sign_bits64(m, 8)),
+                _mm256_blendv_pd(b[3], a[3], sign_bits64(m, 12)),
             ])
         }
     }

@@ -319,6 +319,70 @@ mod tests {
         }
     }
 
+    /// `select` over every mask of 16 lanes: f32 lanes (both widths) and f64 lanes, lane i
+    /// from `a` exactly where bit i is set. Returns the first mask that picked wrongly, per
+    /// vector kind. The mask is rotated left by `.0` bits before `select` sees it: 0 in the
+    /// test, 1 in its control (an off-by-one).
+    struct EveryMask(u32);
+
+    impl Kernel for EveryMask {
+        type Out = [Option<u32>; 3];
+        fn run<L: Lanes>(self) -> Self::Out {
+            let a: [f32; WIDTH] = std::array::from_fn(|i| i as f32 + 1.0);
+            let b = a.map(|x| -x);
+            let (va, vb) = (L::V::load(&a), L::V::load(&b));
+            let (na, nb) = (
+                L::W::load(a[..NARROW].try_into().unwrap()),
+                L::W::load(b[..NARROW].try_into().unwrap()),
+            );
+            let (da, db) = (L::D::from_f32(&a), L::D::from_f32(&b));
+            let right = |m: u32, got: &[f32]| {
+                got.iter()
+                    .enumerate()
+                    .all(|(i, &g)| g == if m >> i & 1 != 0 { a[i] } else { b[i] })
+            };
+            let mut wrong = [None; 3];
+            for m in 0..1u32 << WIDTH {
+                let mut w = [0.0; WIDTH];
+                let given = (m as u16).rotate_left(self.0) as u32;
+                L::V::select(given, va, vb).store(&mut w);
+                let mut n = [0.0; NARROW];
+                L::W::select(given & 0xff, na, nb).store(&mut n);
+                let mut d = [0.0; WIDTH];
+                L::D::select(given, da, db).to_f32(&mut d);
+                for (k, ok) in [right(m, &w), right(m, &n), right(m, &d)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    if !ok && wrong[k].is_none() {
+                        wrong[k] = Some(m);
+                    }
+                }
+            }
+            wrong
+        }
+    }
+
+    /// Every ISA's `select` takes lane i from its first operand exactly where mask bit i is
+    /// set, for all 2¹⁶ masks (the AVX2 path shifts each lane's bit into its sign, the AVX-512
+    /// path reads a k mask, the portable path tests bits: an off-by-one in any of them moves
+    /// a lane). Control: a mask off by one bit is caught at every width on every ISA.
+    #[test]
+    fn select_takes_each_lane_by_its_mask_bit() {
+        for isa in Isa::available() {
+            assert_eq!(
+                run(isa, EveryMask(0)),
+                [None; 3],
+                "{isa:?}: first wrong mask"
+            );
+            let off_by_one = run(isa, EveryMask(1));
+            assert!(
+                off_by_one.iter().all(Option::is_some),
+                "{isa:?}: {off_by_one:?}"
+            );
+        }
+    }
+
     struct Records<'a>(&'a [[f32; 4]], [usize; WIDTH]);
 
     impl Kernel for Records<'_> {
