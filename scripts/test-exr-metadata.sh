@@ -70,6 +70,11 @@ for f in "$run/light.exr" "$ref"; do
     failures=$((failures + 1))
   fi
 done
+# The machine: the same description as run.json's cpu_model, in the images and the reference.
+cpu=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['cpu_model'])" "$run/run.json")
+for f in "$run/light.exr" "$run/light.variance.exr" "$ref"; do
+  expect "$f" cpu "$cpu"
+done
 if [ "$failures" -eq 0 ]; then
   echo "PASS: test-exr-metadata"
 else

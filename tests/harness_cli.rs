@@ -409,6 +409,12 @@ fn sharded_reference_merges_to_the_single_process_one() {
             meta.contains("\"spp\": 30") || meta.contains("\"spp\":30"),
             "{meta}"
         );
+        // The three "machines" are one here: the merged reference names it once.
+        let cpu = serde_json::from_str::<serde_json::Value>(&meta).unwrap()["cpu"]
+            .as_str()
+            .unwrap_or_default()
+            .to_string();
+        assert!(!cpu.is_empty() && !cpu.contains(" | "), "{meta}");
     }
     let (code, _, stderr) = dibench(
         &[
@@ -769,6 +775,20 @@ fn compare_at_equal_spp() {
     let r = dibench::output::read_provenance(&reference)
         .unwrap()
         .unwrap();
+    // The machine, as the run's metadata names it (`cpu_model`), in the images and the
+    // reference alike.
+    let run_json = std::fs::read_to_string(run_dir.join("run.json")).unwrap();
+    let cpu_model = serde_json::from_str::<serde_json::Value>(&run_json).unwrap()["cpu_model"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        cpu_model.contains("family") || cpu_model.contains('('),
+        "{cpu_model}"
+    );
+    assert_eq!(p.cpu.as_deref(), Some(cpu_model.as_str()));
+    assert_eq!(v.cpu.as_deref(), Some(cpu_model.as_str()));
+    assert_eq!(r.cpu.as_deref(), Some(cpu_model.as_str()));
     assert_eq!(
         (r.spp, r.sampler.as_str(), r.scene_hash),
         (64, "independent", p.scene_hash)

@@ -722,6 +722,7 @@ pub fn run(
                     threads: opts.threads,
                     version: VERSION.to_string(),
                     commit: COMMIT.to_string(),
+                    cpu: Some(meta.cpu_model.clone()),
                 };
                 write_exr_with(&dir.join(format!("{stem}.exr")), &r.image, &provenance)?;
                 if g.independent_samples() {

@@ -37,6 +37,10 @@ pub struct ReferenceMeta {
     pub noise_floor_rmse: Option<f64>,
     pub dibench_version: String,
     pub commit: String,
+    /// The machine(s) that rendered it ([`crate::output::Provenance::cpu`]). Absent in
+    /// references stored before.
+    #[serde(default)]
+    pub cpu: Option<String>,
 }
 
 impl ReferenceMeta {
@@ -56,6 +60,7 @@ impl ReferenceMeta {
             threads: self.threads,
             version: self.dibench_version.clone(),
             commit: self.commit.clone(),
+            cpu: self.cpu.clone(),
         }
     }
 }
@@ -213,6 +218,7 @@ pub fn render_with(
         noise_floor_rmse: Some(noise_floor(film)),
         dibench_version: VERSION.to_string(),
         commit: COMMIT.to_string(),
+        cpu: Some(super::cpu_model()),
     };
     let mut next_checkpoint = FIRST_CHECKPOINT_SPP;
     let mut saved = None;

@@ -59,6 +59,10 @@ pub struct ShardMeta {
     pub wall_time_s: f64,
     pub dibench_version: String,
     pub commit: String,
+    /// The machine that rendered the shard ([`super::cpu_model`]). Absent in shards stored
+    /// before.
+    #[serde(default)]
+    pub cpu: Option<String>,
 }
 
 /// The shard store of `scene` under `out`, `<out>/<scene>/reference/shards/` (created if
@@ -132,6 +136,7 @@ pub fn render(
         wall_time_s: start.elapsed().as_secs_f64(),
         dibench_version: VERSION.to_string(),
         commit: COMMIT.to_string(),
+        cpu: Some(super::cpu_model()),
     };
     Ok((film, meta))
 }
@@ -154,6 +159,18 @@ pub fn save_shard(unit: &Locked, film: &Film, meta: &ShardMeta) -> Result<PathBu
             write: Box::new(|f, p| f.write_all(&bytes).map_err(|e| Error::io(p, e))),
         }],
     )
+}
+
+/// The machines of a merged reference's shards, in shard order: each distinct one once,
+/// joined by " | " (a description has a ";" of its own), and "unrecorded" for shards stored before the machine was.
+fn machines<'a>(cpus: impl Iterator<Item = Option<&'a str>>) -> String {
+    let mut seen: Vec<&str> = Vec::new();
+    for cpu in cpus.map(|c| c.unwrap_or("unrecorded")) {
+        if !seen.contains(&cpu) {
+            seen.push(cpu);
+        }
+    }
+    seen.join(" | ")
 }
 
 /// A shard's manifest path, film and metadata.
@@ -351,9 +368,31 @@ pub fn merge(out: &Path, scene: &crate::scene::Scene) -> Result<Vec<PathBuf>> {
             noise_floor_rmse: Some((film.mean_sample_variance() / film.spp as f64).sqrt()),
             dibench_version: VERSION.to_string(),
             commit: COMMIT.to_string(),
+            cpu: Some(machines(shards.iter().map(|s| s.2.cpu.as_deref()))),
         };
         let unit = references.lock(&integrand)?;
         written.push(save(&unit, &film.mean(), &film.variance_of_mean(), &meta)?);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::machines;
+
+    /// A merged reference names each machine of its shards once, in shard order, and shards
+    /// stored before the machine was recorded as "unrecorded" (control: one machine alone is
+    /// itself, not a list).
+    #[test]
+    fn a_merged_reference_names_its_shards_machines() {
+        let (a, b) = (
+            "AMD EPYC (family 25, model 1, stepping 1; avx2)",
+            "Xeon (avx512)",
+        );
+        assert_eq!(machines([Some(a), Some(a)].into_iter()), a);
+        assert_eq!(
+            machines([Some(b), Some(a), Some(b), None].into_iter()),
+            format!("{b} | {a} | unrecorded")
+        );
+    }
 }

@@ -30,6 +30,11 @@ pub struct Provenance {
     pub threads: usize,
     pub version: String,
     pub commit: String,
+    /// The machine that rendered it, as [`crate::harness::cpu_model`] describes it (name,
+    /// family, model, stepping, ISA): timings mean nothing without it. A reference merged from
+    /// shards names each distinct machine once, in shard order, joined by " | ". None in
+    /// images written before it was recorded (no `dibench:cpu` attribute).
+    pub cpu: Option<String>,
 }
 
 /// The attribute-name prefix of [`Provenance`]'s fields.
@@ -84,6 +89,12 @@ impl Provenance {
             name("render_time_s"),
             AttributeValue::F64(self.render_time_s),
         ));
+        if let Some(cpu) = &self.cpu {
+            out.push((
+                name("cpu"),
+                AttributeValue::Text(Text::from_slice_unchecked(cpu.as_bytes())),
+            ));
+        }
         out
     }
 }
@@ -203,6 +214,8 @@ pub fn read_provenance(path: &Path) -> Result<Option<Provenance>> {
         threads: number("threads")? as usize,
         version: text("version")?,
         commit: text("commit")?,
+        // Optional: images written before it was recorded have none.
+        cpu: get("cpu").map(|_| text("cpu")).transpose()?,
     }))
 }
 
@@ -331,6 +344,7 @@ mod tests {
             threads: 2,
             version: "0.1.0".into(),
             commit: "deadbeef".into(),
+            cpu: Some("AMD EPYC (family 25, model 1, stepping 1; avx2)".into()),
         };
         let path = dir.path().join("a.exr");
         write_exr_with(&path, &image(3, 2), &p).unwrap();
@@ -345,6 +359,14 @@ mod tests {
         let plain = dir.path().join("plain.exr");
         write_exr(&plain, &image(3, 2)).unwrap();
         assert_eq!(read_provenance(&plain).unwrap(), None);
+        // An image from before the machine was recorded: no `dibench:cpu`, read as None.
+        let older = dir.path().join("older.exr");
+        let before = Provenance {
+            cpu: None,
+            ..p.clone()
+        };
+        write_exr_with(&older, &image(3, 2), &before).unwrap();
+        assert_eq!(read_provenance(&older).unwrap(), Some(before));
         // The spp attribute's text damaged in place (same length: "109951162777x").
         let mut bytes = std::fs::read(&path).unwrap();
         let digits = (1u64 << 40).to_string();

@@ -69,6 +69,7 @@ fn run_dir(root: &Path, w: u32, h: u32) -> PathBuf {
         noise_floor_rmse: Some(0.01),
         dibench_version: "0".into(),
         commit: "c".into(),
+        cpu: None,
     };
     save(&unit, &image(w, h, 0.0), &image(w, h, 3.0), &meta).unwrap();
     run
