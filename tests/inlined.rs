@@ -13,21 +13,26 @@
 
 use std::process::Command;
 
-/// The `core::core_arch` functions a binary defines (`nm` from binutils, which is installed
-/// wherever Rust links), less those of CPU detection, which runs outside any kernel.
-fn out_of_line_intrinsics(binary: &std::path::Path) -> Vec<String> {
-    let out = Command::new("nm")
-        .args(["-C", "--defined-only"])
+/// The output of binutils' `tool` (installed wherever Rust links) run with `args` on
+/// `binary`; a failure to run it is a test failure naming the tool and the file.
+fn binutils(tool: &str, args: &[&str], binary: &std::path::Path) -> String {
+    let out = Command::new(tool)
+        .args(args)
         .arg(binary)
         .output()
-        .unwrap_or_else(|e| panic!("running nm (binutils) on {}: {e}", binary.display()));
+        .unwrap_or_else(|e| panic!("running {tool} (binutils) on {}: {e}", binary.display()));
     assert!(
         out.status.success(),
-        "nm {}: {}",
+        "{tool} {}: {}",
         binary.display(),
         String::from_utf8_lossy(&out.stderr)
     );
-    let symbols = String::from_utf8_lossy(&out.stdout).into_owned();
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// The `core::core_arch` functions a binary defines (`nm`), less those of CPU detection, which runs outside any kernel.
+fn out_of_line_intrinsics(binary: &std::path::Path) -> Vec<String> {
+    let symbols = binutils("nm", &["-C", "--defined-only"], binary);
     assert!(
         symbols.lines().count() > 1000,
         "{}: no symbol table (stripped?)",
@@ -77,18 +82,7 @@ fn an_intrinsic_outside_its_target_feature_is_found() {
 /// ab_glyph's rasterizer, are not counted), each as "function: instruction".
 #[cfg(target_arch = "x86_64")]
 fn masked_stores(binary: &std::path::Path, path: &str) -> Vec<String> {
-    let out = Command::new("objdump")
-        .args(["-d", "-C", "--no-show-raw-insn"])
-        .arg(binary)
-        .output()
-        .unwrap_or_else(|e| panic!("running objdump (binutils) on {}: {e}", binary.display()));
-    assert!(
-        out.status.success(),
-        "objdump {}: {}",
-        binary.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let text = String::from_utf8_lossy(&out.stdout);
+    let text = binutils("objdump", &["-d", "-C", "--no-show-raw-insn"], binary);
     let mut function = "";
     let (mut instructions, mut found) = (0usize, Vec::new());
     for line in text.lines() {

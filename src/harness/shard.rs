@@ -162,7 +162,8 @@ pub fn save_shard(unit: &Locked, film: &Film, meta: &ShardMeta) -> Result<PathBu
 }
 
 /// The machines of a merged reference's shards, in shard order: each distinct one once,
-/// joined by " | " (a description has a ";" of its own), and "unrecorded" for shards stored before the machine was.
+/// joined by " | " (a description has a ";" of its own), and "unrecorded" for shards stored
+/// before the machine was.
 fn machines<'a>(cpus: impl Iterator<Item = Option<&'a str>>) -> String {
     let mut seen: Vec<&str> = Vec::new();
     for cpu in cpus.map(|c| c.unwrap_or("unrecorded")) {

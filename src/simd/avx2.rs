@@ -112,6 +112,14 @@ macro_rules! cmp {
     };
 }
 
+impl Y {
+    /// Lane i of `a` where bit `first + i` of the broadcast mask `m` is set, else of `b`.
+    #[inline(always)]
+    fn blend(m: __m256i, first: i32, a: Y, b: Y) -> Y {
+        unsafe { Y(_mm256_blendv_ps(b.0, a.0, sign_bits(m, first))) }
+    }
+}
+
 impl Vector<NARROW> for Y {
     #[inline(always)]
     fn splat(x: f32) -> Self {
@@ -180,10 +188,7 @@ impl Vector<NARROW> for Y {
     }
     #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
-        unsafe {
-            let m = sign_bits(_mm256_set1_epi32(m as i32), 0);
-            Y(_mm256_blendv_ps(b.0, a.0, m))
-        }
+        unsafe { Y::blend(_mm256_set1_epi32(m as i32), 0, a, b) }
     }
     #[inline(always)]
     fn reduce_min(self) -> f32 {
@@ -298,13 +303,9 @@ impl Vector<WIDTH> for Y2 {
     }
     #[inline(always)]
     fn select(m: u32, a: Self, b: Self) -> Self {
-        unsafe {
-            let m = _mm256_set1_epi32(m as i32);
-            Y2(
-                Y(_mm256_blendv_ps(b.0.0, a.0.0, sign_bits(m, 0))),
-                Y(_mm256_blendv_ps(b.1.0, a.1.0, sign_bits(m, 8))),
-            )
-        }
+        // One broadcast of the mask for both registers.
+        let m = unsafe { _mm256_set1_epi32(m as i32) };
+        Y2(Y::blend(m, 0, a.0, b.0), Y::blend(m, 8, a.1, b.1))
     }
     #[inline(always)]
     fn reduce_min(self) -> f32 {
