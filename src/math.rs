@@ -25,7 +25,7 @@ impl Frame {
     /// [`Self::from_normal`] over lanes, bit for bit: the (s, t) of each lane's unit normal.
     #[inline(always)]
     pub fn from_normal_lanes<V: Vector<WIDTH>>(n: V3<V>) -> (V3<V>, V3<V>) {
-        let sign = V::select(n.z.sign(), V::splat(-1.0), V::splat(1.0));
+        let sign = n.z.sign_select(V::splat(-1.0), V::splat(1.0));
         let a = V::splat(-1.0).div(sign.add(n.z));
         let b = n.x.mul(n.y).mul(a);
         let s = V3 {
@@ -61,10 +61,11 @@ pub fn atan2<V: Vector<N>, const N: usize>(y: V, x: V) -> V {
     let (ax, ay) = (x.abs(), y.abs());
     let (lo, hi) = (ax.min(ay), ax.max(ay));
     let zero = V::splat(0.0);
-    let a = lo.div(V::select(hi.eq(zero), V::splat(1.0), hi));
     let one = V::splat(1.0);
-    let above = V::splat(0.414_213_57).lt(a);
-    let t = V::select(above, a.sub(one).div(a.add(one)), a);
+    // hi ≥ 0, so hi ≤ 0 is hi = 0.
+    let a = lo.div(hi.le_select(zero, one, hi));
+    let tan_pi_8 = V::splat(0.414_213_57);
+    let t = tan_pi_8.lt_select(a, a.sub(one).div(a.add(one)), a);
     let z = t.mul(t);
     let p = V::splat(8.053_744_5e-2)
         .mul(z)
@@ -76,11 +77,11 @@ pub fn atan2<V: Vector<N>, const N: usize>(y: V, x: V) -> V {
         .mul(z)
         .mul(t)
         .add(t);
-    let r = V::select(above, V::splat(FRAC_PI_4).add(p), p);
+    let r = tan_pi_8.lt_select(a, V::splat(FRAC_PI_4).add(p), p);
     // Back to the octant, the half plane and the sign of y.
-    let r = V::select(ax.lt(ay), V::splat(FRAC_PI_2).sub(r), r);
-    let r = V::select(x.lt(zero), V::splat(PI).sub(r), r);
-    V::select(y.sign(), r.neg(), r)
+    let r = ax.lt_select(ay, V::splat(FRAC_PI_2).sub(r), r);
+    let r = x.lt_select(zero, V::splat(PI).sub(r), r);
+    y.sign_select(r.neg(), r)
 }
 
 /// x rounded to the nearest integer (ties to even) by adding and subtracting 1.5·2⁵²: IEEE
@@ -154,7 +155,7 @@ pub fn sin_cos64<D: Vector64<N>, const N: usize>(x: D) -> (D, D) {
     let split = h.mul(c(134_217_729.0));
     let qx = split.sub(split.sub(h));
     let far = c(1.0).sub(qx).sub(h.sub(qx).sub(zr));
-    let cos = D::select(zz.lt(c(0.09)), near, far);
+    let cos = zz.lt_select(c(0.09), near, far);
     // The quadrant n mod 4, exactly: n − 4·⌊n/4⌋, with ⌊n/4⌋ = round(n/4 − 3/8) for integer n.
     let q = n.sub(c(4.0).mul(round64(n.mul(c(0.25)).sub(c(0.375)))));
     let odd = q.eq(c(1.0)) | q.eq(c(3.0));
@@ -205,8 +206,7 @@ pub fn acos64<D: Vector64<N>, const N: usize>(x: D) -> D {
     let pio2_hi = std::f64::consts::FRAC_PI_2;
     let pio2_lo = 6.123_233_995_736_766e-17;
     let ax = x.abs();
-    let small = ax.le(c(0.5));
-    let z = D::select(small, x.mul(x), c(1.0).sub(ax).mul(c(0.5)));
+    let z = ax.le_select(c(0.5), x.mul(x), c(1.0).sub(ax).mul(c(0.5)));
     let r = asin_r(z);
     let near = c(pio2_hi).sub(x.sub(c(pio2_lo).sub(x.mul(r))));
     let s = z.sqrt();
@@ -215,11 +215,13 @@ pub fn acos64<D: Vector64<N>, const N: usize>(x: D) -> D {
     // x > 1/2: 2·(df + (s·R + (z − df²)/(s + df))), df the high half of s (exact square).
     let split = s.mul(c(134_217_729.0));
     let df = split.sub(split.sub(s));
-    let zero = s.eq(c(0.0));
-    let tail = z.sub(df.mul(df)).div(D::select(zero, c(1.0), s.add(df)));
+    // s ≥ 0, so s ≤ 0 is s = 0.
+    let tail = z
+        .sub(df.mul(df))
+        .div(s.le_select(c(0.0), c(1.0), s.add(df)));
     let above = c(2.0).mul(df.add(r.mul(s).add(tail)));
-    let far = D::select(x.sign(), below, above);
-    D::select(small, near, far)
+    let far = x.sign_select(below, above);
+    ax.le_select(c(0.5), near, far)
 }
 
 /// asin x in f64 for x ∈ [−1, 1], written once over lanes (see [`sin_cos64`]). fdlibm's
@@ -233,8 +235,7 @@ pub fn asin64<D: Vector64<N>, const N: usize>(x: D) -> D {
     let pio2_lo = 6.123_233_995_736_766e-17;
     let pio4_hi = std::f64::consts::FRAC_PI_4;
     let ax = x.abs();
-    let small = ax.lt(c(0.5));
-    let z = D::select(small, x.mul(x), c(1.0).sub(ax).mul(c(0.5)));
+    let z = ax.lt_select(c(0.5), x.mul(x), c(1.0).sub(ax).mul(c(0.5)));
     let r = asin_r(z);
     let near = x.add(x.mul(r));
     let s = z.sqrt();
@@ -244,14 +245,16 @@ pub fn asin64<D: Vector64<N>, const N: usize>(x: D) -> D {
     // exact square) and tail = (z − df²)/(s + df) what it leaves of √z.
     let split = s.mul(c(134_217_729.0));
     let df = split.sub(split.sub(s));
-    let zero = s.eq(c(0.0));
-    let tail = z.sub(df.mul(df)).div(D::select(zero, c(1.0), s.add(df)));
+    // s ≥ 0, so s ≤ 0 is s = 0.
+    let tail = z
+        .sub(df.mul(df))
+        .div(s.le_select(c(0.0), c(1.0), s.add(df)));
     let p = c(2.0).mul(s).mul(r).sub(c(pio2_lo).sub(c(2.0).mul(tail)));
     let q = c(pio4_hi).sub(c(2.0).mul(df));
     let mid = c(pio4_hi).sub(p.sub(q));
-    let far = D::select(c(0.975).le(ax), top, mid);
-    let far = D::select(x.sign(), far.neg(), far);
-    D::select(small, near, far)
+    let far = c(0.975).le_select(ax, top, mid);
+    let far = x.sign_select(far.neg(), far);
+    ax.lt_select(c(0.5), near, far)
 }
 
 /// atan2(y, x) in f64 for y ≥ 0, written once over lanes, by the inverse sine or cosine of the
@@ -262,14 +265,14 @@ pub fn asin64<D: Vector64<N>, const N: usize>(x: D) -> D {
 pub fn atan2_64_upper<D: Vector64<N>, const N: usize>(y: D, x: D) -> D {
     let c = D::splat;
     let r = x.mul(x).add(y.mul(y)).sqrt();
-    let origin = r.eq(c(0.0));
-    let r = D::select(origin, c(1.0), r);
-    let (sy, sx) = (y.div(r).min(c(1.0)), x.div(r).max(c(-1.0)).min(c(1.0)));
-    let steep = x.abs().le(r.mul(c(0.5)));
+    // r ≥ 0, so r ≤ 0 is the origin.
+    let (zero, one) = (c(0.0), c(1.0));
+    let rr = r.le_select(zero, one, r);
+    let (sy, sx) = (y.div(rr).min(one), x.div(rr).max(c(-1.0)).min(one));
     let a = asin64(sy);
-    let flat = D::select(x.sign(), c(std::f64::consts::PI).sub(a), a);
-    let t = D::select(steep, acos64(sx), flat);
-    D::select(origin, c(0.0), t)
+    let flat = x.sign_select(c(std::f64::consts::PI).sub(a), a);
+    let t = x.abs().le_select(rr.mul(c(0.5)), acos64(sx), flat);
+    r.le_select(zero, zero, t)
 }
 
 /// γₙ = nε/(1 − nε) with ε = 2⁻²⁴: a bound on the relative error of n chained f32 operations
@@ -316,7 +319,7 @@ pub fn offset_ray_origin_lanes<V: Vector<WIDTH>>(p: V3<V>, p_error: V3<V>, n: V3
 #[inline(always)]
 fn step_off<V: Vector<WIDTH>>(po: V, off: V) -> V {
     let zero = V::splat(0.0);
-    V::select(zero.lt(off.abs()), po.next_f32(zero.lt(off)), po)
+    zero.lt_select(off.abs(), po.next_f32(zero.lt(off)), po)
 }
 
 /// `x.next_up()` if `up`, else `x.next_down()`, bit for bit (the `next_f32_is_std` test),

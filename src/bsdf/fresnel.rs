@@ -69,8 +69,8 @@ pub fn schlick_weight(c: f32) -> f32 {
 #[inline(always)]
 pub fn clamp01_lanes<V: Vector<N>, const N: usize>(c: V) -> V {
     let (zero, one) = (V::splat(0.0), V::splat(1.0));
-    let c = V::select(c.lt(zero), zero, c);
-    V::select(one.lt(c), one, c)
+    let c = c.lt_select(zero, zero, c);
+    one.lt_select(c, one, c)
 }
 
 /// [`schlick_weight`] over lanes.
@@ -216,7 +216,7 @@ impl<V: Vector<WIDTH>> CLanes<V> {
         let im = V::select(
             right,
             half.mul(self.im).div(t),
-            V::select(self.im.sign(), t.neg(), t),
+            self.im.sign_select(t.neg(), t),
         );
         CLanes::new(V::select(null, zero, re), V::select(null, zero, im))
     }

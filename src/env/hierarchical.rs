@@ -146,12 +146,12 @@ impl HierarchicalWarp {
             let target = u0.mul(V::splat(total));
             let (mut lo, mut hi) = (zero, V::splat(total));
             for &c in &self.tile_cdf[1..tiles] {
-                let past = V::splat(c).le(target);
-                tile = tile.add(V::select(past, one, zero));
-                lo = V::select(past, V::splat(c), lo);
+                let c = V::splat(c);
+                tile = tile.add(c.le_select(target, one, zero));
+                lo = c.le_select(target, c, lo);
             }
             for &c in self.tile_cdf[1..tiles].iter().rev() {
-                hi = V::select(V::splat(c).le(target), hi, V::splat(c));
+                hi = V::splat(c).le_select(target, hi, V::splat(c));
             }
             u0 = target
                 .sub(lo)
@@ -190,10 +190,11 @@ impl HierarchicalWarp {
                 );
             }
             let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at);
-            let (right, u0n) = split(c00.add(c01), c10.add(c11), u0);
-            let (top, bottom) = (V::select(right, c10, c00), V::select(right, c11, c01));
-            let (down, u1n) = split(top, bottom, u1);
-            let (r, d) = (V::select(right, one, zero), V::select(down, one, zero));
+            let (px, u0n) = split(c00.add(c01), c10.add(c11), u0);
+            // The left column where u₀ < p (as `split` chose).
+            let (top, bottom) = (u0.lt_select(px, c00, c10), u0.lt_select(px, c01, c11));
+            let (py, u1n) = split(top, bottom, u1);
+            let (r, d) = (u0.lt_select(px, zero, one), u1.lt_select(py, zero, one));
             x = x.add(x).add(r);
             y = y.add(y).add(d);
             m = m.mul(V::splat(4.0)).add(r).add(d.add(d));
@@ -249,18 +250,16 @@ fn morton(x: usize, y: usize) -> usize {
     m
 }
 
-/// Per lane, the second half (bit set) with probability b/(a + b), else the first, and u
+/// Per lane, the probability p = a/(a + b) of the first half, chosen where u < p, and u
 /// rescaled into the chosen half. Only called on nodes of positive sum. The divisor is never
 /// zero: the first half is chosen only when u < p, so p > 0; the second only when u ≥ p, and
 /// p = 1 exactly when b = 0 (a/a), which no u < 1 reaches, so 1 − p > 0.
 #[inline(always)]
-fn split<V: Vector<N>, const N: usize>(a: V, b: V, u: V) -> (u32, V) {
+fn split<V: Vector<N>, const N: usize>(a: V, b: V, u: V) -> (V, V) {
     let p = a.div(a.add(b));
-    let first = u.lt(p);
-    let num = V::select(first, u, u.sub(p));
-    let den = V::select(first, p, V::splat(1.0).sub(p));
-    let all = (u64::MAX >> (64 - N)) as u32;
-    (!first & all, num.div(den).min(V::splat(ONE_MINUS_EPSILON)))
+    let num = u.lt_select(p, u, u.sub(p));
+    let den = u.lt_select(p, p, V::splat(1.0).sub(p));
+    (p, num.div(den).min(V::splat(ONE_MINUS_EPSILON)))
 }
 
 #[cfg(test)]

@@ -20,7 +20,7 @@ pub fn dir_to_uv(w: Vec3) -> [f32; 2] {
 #[inline(always)]
 pub fn dir_to_uv_lanes<V: Vector<N>, const N: usize>(x: V, y: V, z: V) -> (V, V) {
     let phi = atan2(z, x);
-    let phi = V::select(phi.lt(V::splat(0.0)), phi.add(V::splat(2.0 * PI)), phi);
+    let phi = phi.lt_select(V::splat(0.0), phi.add(V::splat(2.0 * PI)), phi);
     // atan2 of (sin θ, cos θ): accurate at the poles, where acos is not.
     let theta = atan2(x.mul(x).add(z.mul(z)).sqrt(), y);
     (

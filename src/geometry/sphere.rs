@@ -110,7 +110,7 @@ impl Sphere {
         }
         let c = dot3(f, f).sub(r2);
         // b.signum(): −1 where the sign bit is set (−0.0 included).
-        let sign = D::select(b.sign(), D::splat(-1.0), D::splat(1.0));
+        let sign = b.sign_select(D::splat(-1.0), D::splat(1.0));
         let q = b.add(sign.mul(D::select(hit, disc, zero).sqrt()));
         hit &= !q.eq(zero);
         let x = c.div(D::select(hit, q, D::splat(1.0)));

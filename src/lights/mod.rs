@@ -955,7 +955,7 @@ fn selection_number_lanes<D: Vector64<WIDTH>>(hi: &[f32; WIDTH], lo: &[f32; WIDT
     let x = D::from_f32(hi).mul(D::splat(GRID));
     let big = D::splat(4_503_599_627_370_496.0);
     let near = x.add(big).sub(big);
-    let floor = near.sub(D::select(x.lt(near), D::splat(1.0), D::splat(0.0)));
+    let floor = near.sub(x.lt_select(near, D::splat(1.0), D::splat(0.0)));
     let unit = D::splat(1.0 / GRID);
     floor.mul(unit).add(D::from_f32(lo).mul(unit))
 }

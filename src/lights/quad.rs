@@ -127,7 +127,7 @@ impl QuadLight {
         let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
         let d2 = d.dot(d);
         let cos_l = V3::splat(self.normal).dot(d).neg().div(d2.sqrt());
-        V::select(zero.lt(cos_l), d2.div(V::splat(self.area).mul(cos_l)), zero)
+        zero.lt_select(cos_l, d2.div(V::splat(self.area).mul(cos_l)), zero)
     }
 
     /// [`Self::pdf_solid_angle`] for the lanes of `a`, bit for bit; other lanes of `out` are

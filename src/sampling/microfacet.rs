@@ -200,7 +200,7 @@ impl Ggx {
         let (x, y) = (h.x.div(V::splat(self.ax)), h.y.div(V::splat(self.ay)));
         let s = x.mul(x).add(y.mul(y)).add(h.z.mul(h.z));
         let d = V::splat(1.0).div(V::splat(PI * self.ax * self.ay).mul(s).mul(s));
-        V::select(h.z.le(zero), zero, d)
+        h.z.le_select(zero, zero, d)
     }
 
     /// [`Self::stretched_len`] over lanes.

@@ -270,7 +270,7 @@ impl<D: Copy> SphericalRectangle<D> {
         let (sin_au, cos_au) = sin_cos64(au);
         let fu = cos_au.mul(self.b0).sub(self.b1).div(sin_au);
         let inv = one.div(fu.mul(fu).add(self.b0.mul(self.b0)).sqrt());
-        let cu = clamp(D::select(fu.sign(), inv.neg(), inv), c(-1.0), one);
+        let cu = clamp(fu.sign_select(inv.neg(), inv), c(-1.0), one);
         let den = one.sub(cu.mul(cu)).max(zero).sqrt();
         let edge = den.eq(zero);
         let xu = clamp(
@@ -278,7 +278,7 @@ impl<D: Copy> SphericalRectangle<D> {
             self.x0,
             self.x1,
         );
-        let xu = D::select(edge, D::select(cu.sign(), self.x0, self.x1), xu);
+        let xu = D::select(edge, cu.sign_select(self.x0, self.x1), xu);
         let d = xu.mul(xu).add(self.z0.mul(self.z0)).sqrt();
         let h0 = self.y0.div(d.mul(d).add(self.y0.mul(self.y0)).sqrt());
         let h1 = self.y1.div(d.mul(d).add(self.y1.mul(self.y1)).sqrt());

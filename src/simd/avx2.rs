@@ -103,6 +103,16 @@ macro_rules! op {
     };
 }
 
+macro_rules! cmp_select {
+    ($name:ident, $p:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self, a: Self, b: Self) -> Self {
+            // blendv takes its second operand where the compare set the lane's sign bit.
+            unsafe { Y(_mm256_blendv_ps(b.0, a.0, _mm256_cmp_ps::<$p>(self.0, o.0))) }
+        }
+    };
+}
+
 macro_rules! cmp {
     ($name:ident, $p:ident) => {
         #[inline(always)]
@@ -181,6 +191,12 @@ impl Vector<NARROW> for Y {
     }
     cmp!(lt, _CMP_LT_OQ);
     cmp!(le, _CMP_LE_OQ);
+    cmp_select!(lt_select, _CMP_LT_OQ);
+    cmp_select!(le_select, _CMP_LE_OQ);
+    #[inline(always)]
+    fn sign_select(self, a: Self, b: Self) -> Self {
+        unsafe { Y(_mm256_blendv_ps(b.0, a.0, self.0)) }
+    }
     cmp!(eq, _CMP_EQ_OQ);
     #[inline(always)]
     fn sign(self) -> u32 {
@@ -298,6 +314,24 @@ impl Vector<WIDTH> for Y2 {
     both_cmp!(le);
     both_cmp!(eq);
     #[inline(always)]
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self {
+        Y2(
+            self.0.lt_select(o.0, a.0, b.0),
+            self.1.lt_select(o.1, a.1, b.1),
+        )
+    }
+    #[inline(always)]
+    fn le_select(self, o: Self, a: Self, b: Self) -> Self {
+        Y2(
+            self.0.le_select(o.0, a.0, b.0),
+            self.1.le_select(o.1, a.1, b.1),
+        )
+    }
+    #[inline(always)]
+    fn sign_select(self, a: Self, b: Self) -> Self {
+        Y2(self.0.sign_select(a.0, b.0), self.1.sign_select(a.1, b.1))
+    }
+    #[inline(always)]
     fn sign(self) -> u32 {
         self.0.sign() | (self.1.sign() << 8)
     }
@@ -345,6 +379,23 @@ macro_rules! op64 {
                     $f(a[1], b[1]),
                     $f(a[2], b[2]),
                     $f(a[3], b[3]),
+                ])
+            }
+        }
+    };
+}
+
+macro_rules! cmp_select64 {
+    ($name:ident, $p:ident) => {
+        #[inline(always)]
+        fn $name(self, o: Self, a: Self, b: Self) -> Self {
+            let (x, y, a, b) = (self.0, o.0, a.0, b.0);
+            unsafe {
+                YD([
+                    _mm256_blendv_pd(b[0], a[0], _mm256_cmp_pd::<$p>(x[0], y[0])),
+                    _mm256_blendv_pd(b[1], a[1], _mm256_cmp_pd::<$p>(x[1], y[1])),
+                    _mm256_blendv_pd(b[2], a[2], _mm256_cmp_pd::<$p>(x[2], y[2])),
+                    _mm256_blendv_pd(b[3], a[3], _mm256_cmp_pd::<$p>(x[3], y[3])),
                 ])
             }
         }
@@ -450,6 +501,20 @@ impl Vector64<WIDTH> for YD {
     cmp64!(lt, _CMP_LT_OQ);
     cmp64!(le, _CMP_LE_OQ);
     cmp64!(eq, _CMP_EQ_OQ);
+    cmp_select64!(lt_select, _CMP_LT_OQ);
+    cmp_select64!(le_select, _CMP_LE_OQ);
+    #[inline(always)]
+    fn sign_select(self, a: Self, b: Self) -> Self {
+        let (x, a, b) = (self.0, a.0, b.0);
+        unsafe {
+            YD([
+                _mm256_blendv_pd(b[0], a[0], x[0]),
+                _mm256_blendv_pd(b[1], a[1], x[1]),
+                _mm256_blendv_pd(b[2], a[2], x[2]),
+                _mm256_blendv_pd(b[3], a[3], x[3]),
+            ])
+        }
+    }
     #[inline(always)]
     fn sign(self) -> u32 {
         let a = self.0;

@@ -56,6 +56,25 @@ pub trait Vector<const N: usize>: Copy {
     fn sign(self) -> u32;
     /// Lane i = `a` where bit i of `m` is set, else `b`.
     fn select(m: u32, a: Self, b: Self) -> Self;
+    /// `select(self.lt(o), a, b)`, the mask kept in the registers: AVX2 has no mask
+    /// registers, so a mask that goes out to bits and back costs a movemask, a broadcast and
+    /// a shift on the way to the blend; here the compare feeds the blend. Same lanes, bit for
+    /// bit.
+    #[inline(always)]
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self {
+        Self::select(self.lt(o), a, b)
+    }
+    /// `select(self.le(o), a, b)`, as [`Self::lt_select`].
+    #[inline(always)]
+    fn le_select(self, o: Self, a: Self, b: Self) -> Self {
+        Self::select(self.le(o), a, b)
+    }
+    /// `select(self.sign(), a, b)`, as [`Self::lt_select`]: AVX2's blend reads the sign bit
+    /// itself, so this is one instruction.
+    #[inline(always)]
+    fn sign_select(self, a: Self, b: Self) -> Self {
+        Self::select(self.sign(), a, b)
+    }
     /// The smallest lane (for NaN-free lanes the result does not depend on the order).
     fn reduce_min(self) -> f32;
     /// The largest lane (likewise).
@@ -116,6 +135,21 @@ pub trait Vector64<const N: usize>: Copy {
     fn sign(self) -> u32;
     /// Lane i = `a` where bit i of `m` is set, else `b`.
     fn select(m: u32, a: Self, b: Self) -> Self;
+    /// `select(self.lt(o), a, b)`, the mask kept in the registers ([`Vector::lt_select`]).
+    #[inline(always)]
+    fn lt_select(self, o: Self, a: Self, b: Self) -> Self {
+        Self::select(self.lt(o), a, b)
+    }
+    /// `select(self.le(o), a, b)`, likewise.
+    #[inline(always)]
+    fn le_select(self, o: Self, a: Self, b: Self) -> Self {
+        Self::select(self.le(o), a, b)
+    }
+    /// `select(self.sign(), a, b)`, likewise ([`Vector::sign_select`]).
+    #[inline(always)]
+    fn sign_select(self, a: Self, b: Self) -> Self {
+        Self::select(self.sign(), a, b)
+    }
 }
 
 /// A u64 vector of `N` lanes with wrapping arithmetic, for the random streams' 64-bit state
@@ -380,6 +414,125 @@ mod tests {
                 off_by_one.iter().all(Option::is_some),
                 "{isa:?}: {off_by_one:?}"
             );
+        }
+    }
+
+    /// `lt_select`, `le_select` and `sign_select` at both f32 widths and on f64 lanes, against
+    /// each lane's comparison in Rust (`<`, `<=`, `is_sign_negative`) on operands with ties,
+    /// ±0, NaN of both signs, infinities and subnormals. Returns the first wrong case, if any.
+    /// `.0` swaps `lt_select` and `le_select` (the control).
+    struct FusedSelects(bool);
+
+    impl Kernel for FusedSelects {
+        type Out = Option<String>;
+        fn run<L: Lanes>(self) -> Self::Out {
+            let nan = f32::NAN;
+            let a: [f32; WIDTH] = [
+                -0.0,
+                0.0,
+                1.0,
+                nan,
+                -nan,
+                f32::INFINITY,
+                -f32::INFINITY,
+                2.5,
+                -3.0,
+                1e-40,
+                -1e-40,
+                7.0,
+                0.0,
+                -1.0,
+                3.0,
+                nan,
+            ];
+            let b: [f32; WIDTH] = [
+                0.0,
+                -0.0,
+                1.0,
+                1.0,
+                0.0,
+                f32::INFINITY,
+                0.0,
+                2.5,
+                3.0,
+                0.0,
+                0.0,
+                6.0,
+                nan,
+                -1.0,
+                4.0,
+                0.0,
+            ];
+            let p: [f32; WIDTH] = std::array::from_fn(|i| i as f32 + 1.0);
+            let q = p.map(|x| -x);
+            let want = |k: usize, i: usize| {
+                let take = match k {
+                    0 => a[i] < b[i],
+                    1 => a[i] <= b[i],
+                    _ => a[i].is_sign_negative(),
+                };
+                if take { p[i] } else { q[i] }
+            };
+            let swap = self.0;
+            let wide = |k: usize| {
+                let (x, y) = (L::V::load(&a), L::V::load(&b));
+                let (vp, vq) = (L::V::load(&p), L::V::load(&q));
+                let mut o = [0.0; WIDTH];
+                match (k, swap) {
+                    (0, false) | (1, true) => x.lt_select(y, vp, vq),
+                    (0, true) | (1, false) => x.le_select(y, vp, vq),
+                    _ => x.sign_select(vp, vq),
+                }
+                .store(&mut o);
+                o.to_vec()
+            };
+            let narrow = |k: usize| {
+                let h = |v: &[f32; WIDTH]| L::W::load(v[..NARROW].try_into().unwrap());
+                let (x, y, vp, vq) = (h(&a), h(&b), h(&p), h(&q));
+                let mut o = [0.0; NARROW];
+                match (k, swap) {
+                    (0, false) | (1, true) => x.lt_select(y, vp, vq),
+                    (0, true) | (1, false) => x.le_select(y, vp, vq),
+                    _ => x.sign_select(vp, vq),
+                }
+                .store(&mut o);
+                o.to_vec()
+            };
+            let double = |k: usize| {
+                let (x, y) = (L::D::from_f32(&a), L::D::from_f32(&b));
+                let (vp, vq) = (L::D::from_f32(&p), L::D::from_f32(&q));
+                let mut o = [0.0; WIDTH];
+                match (k, swap) {
+                    (0, false) | (1, true) => x.lt_select(y, vp, vq),
+                    (0, true) | (1, false) => x.le_select(y, vp, vq),
+                    _ => x.sign_select(vp, vq),
+                }
+                .to_f32(&mut o);
+                o.to_vec()
+            };
+            for k in 0..3 {
+                for (kind, got) in [("f32", wide(k)), ("narrow", narrow(k)), ("f64", double(k))] {
+                    for (i, &g) in got.iter().enumerate() {
+                        if g != want(k, i) {
+                            let op = ["lt_select", "le_select", "sign_select"][k];
+                            return Some(format!("{op} {kind} lane {i}: {} vs {}", a[i], b[i]));
+                        }
+                    }
+                }
+            }
+            None
+        }
+    }
+
+    /// Every ISA's fused compare-and-select takes the lanes its comparison (or sign bit) says,
+    /// as `select` of the comparison does (the AVX2 path feeds the compare to the blend
+    /// directly, the others go through mask bits). Control: `lt_select` and `le_select`
+    /// swapped is caught (the operands hold ties) on every ISA.
+    #[test]
+    fn fused_selects_take_the_lanes_their_comparison_says() {
+        for isa in Isa::available() {
+            assert_eq!(run(isa, FusedSelects(false)), None, "{isa:?}");
+            assert!(run(isa, FusedSelects(true)).is_some(), "{isa:?}: control");
         }
     }
 

@@ -90,9 +90,8 @@ impl<V: Vector<WIDTH>> Prep<V> {
         let mut inv = [zero; 3];
         let mut inv_a = [[0.0; WIDTH]; 3];
         for a in 0..3 {
-            let small = d[a].abs().lt(tiny);
-            let huge = V::select(d[a].sign(), neg_big, pos_big);
-            inv[a] = V::select(small, huge, one.div(d[a]));
+            let huge = d[a].sign_select(neg_big, pos_big);
+            inv[a] = d[a].abs().lt_select(tiny, huge, one.div(d[a]));
             inv[a].store(&mut inv_a[a]);
         }
         // WatertightRay::new across lanes: kz = the dominant axis, (kx, ky) the next two,

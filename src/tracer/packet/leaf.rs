@@ -60,7 +60,7 @@ pub fn watertight<V: Vector<N>, const N: usize, const FAULT: u32>(
     if hit != 0 {
         let ts = u.mul(az).add(v.mul(bz)).add(w.mul(cz));
         // ts · sign(det): exact, since sign(det) = ±1.
-        let tss = V::select(det.lt(zero), zero.sub(ts), ts);
+        let tss = det.lt_select(zero, zero.sub(ts), ts);
         hit &= zero.lt(tss) & tss.lt(tmax.mul(det.abs()));
         // t within the test's error bound (pbrt-v4 §6.8.7): same expression, same order as
         // the scalar test, and skipped, as there, for triangles wholly ahead of the origin
