@@ -30,7 +30,8 @@ fn binutils(tool: &str, args: &[&str], binary: &std::path::Path) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-/// The `core::core_arch` functions a binary defines (`nm`), less those of CPU detection, which runs outside any kernel.
+/// The `core::core_arch` functions a binary defines (`nm`), less those of CPU detection,
+/// which runs outside any kernel.
 fn out_of_line_intrinsics(binary: &std::path::Path) -> Vec<String> {
     let symbols = binutils("nm", &["-C", "--defined-only"], binary);
     assert!(

@@ -474,30 +474,6 @@ mod tests {
                 if take { p[i] } else { q[i] }
             };
             let swap = self.0;
-            let wide = |k: usize| {
-                let (x, y) = (L::V::load(&a), L::V::load(&b));
-                let (vp, vq) = (L::V::load(&p), L::V::load(&q));
-                let mut o = [0.0; WIDTH];
-                match (k, swap) {
-                    (0, false) | (1, true) => x.lt_select(y, vp, vq),
-                    (0, true) | (1, false) => x.le_select(y, vp, vq),
-                    _ => x.sign_select(vp, vq),
-                }
-                .store(&mut o);
-                o.to_vec()
-            };
-            let narrow = |k: usize| {
-                let h = |v: &[f32; WIDTH]| L::W::load(v[..NARROW].try_into().unwrap());
-                let (x, y, vp, vq) = (h(&a), h(&b), h(&p), h(&q));
-                let mut o = [0.0; NARROW];
-                match (k, swap) {
-                    (0, false) | (1, true) => x.lt_select(y, vp, vq),
-                    (0, true) | (1, false) => x.le_select(y, vp, vq),
-                    _ => x.sign_select(vp, vq),
-                }
-                .store(&mut o);
-                o.to_vec()
-            };
             let double = |k: usize| {
                 let (x, y) = (L::D::from_f32(&a), L::D::from_f32(&b));
                 let (vp, vq) = (L::D::from_f32(&p), L::D::from_f32(&q));
@@ -510,6 +486,10 @@ mod tests {
                 .to_f32(&mut o);
                 o.to_vec()
             };
+            let (wide, narrow) = (
+                |k| fused::<L::V, WIDTH>(k, swap, [&a, &b, &p, &q]),
+                |k| fused::<L::W, NARROW>(k, swap, [&a, &b, &p, &q]),
+            );
             for k in 0..3 {
                 for (kind, got) in [("f32", wide(k)), ("narrow", narrow(k)), ("f64", double(k))] {
                     for (i, &g) in got.iter().enumerate() {
@@ -522,6 +502,24 @@ mod tests {
             }
             None
         }
+    }
+
+    /// Fused select `k` (0 `lt_select`, 1 `le_select`, 2 `sign_select`; 0 and 1 swapped with
+    /// `swap`) of the first N lanes of `[a, b, p, q]`: `a` against `b`, taking `p` or `q`.
+    fn fused<V: Vector<N>, const N: usize>(
+        k: usize,
+        swap: bool,
+        v: [&[f32; WIDTH]; 4],
+    ) -> Vec<f32> {
+        let [x, y, vp, vq] = v.map(|r| V::load(r[..N].try_into().unwrap()));
+        let mut o = [0.0; N];
+        match (k, swap) {
+            (0, false) | (1, true) => x.lt_select(y, vp, vq),
+            (0, true) | (1, false) => x.le_select(y, vp, vq),
+            _ => x.sign_select(vp, vq),
+        }
+        .store(&mut o);
+        o.to_vec()
     }
 
     /// Every ISA's fused compare-and-select takes the lanes its comparison (or sign bit) says,
