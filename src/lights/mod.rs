@@ -487,6 +487,11 @@ pub struct LaneKernel {
     /// Lane i of `out`, for each lane of `active`, is what [`Light::sample`] of the light whose
     /// record is lane i of `records` returns, bit for bit (other lanes are left as they were).
     pub sample: fn(Isa, &LaneRecords, &LaneQuery, u32, &LightMethods, &mut LaneSamples),
+    /// The sampler's pdf beside it: lane i of `out`, for each lane of `active`, is
+    /// [`Light::pdf`] of the light whose record is lane i of `records` at lane i of `at`, bit
+    /// for bit (other lanes are left as they were). The MIS weight of emission probes whose
+    /// lanes hit different lights of this type (an emissive mesh's triangles).
+    pub pdf: fn(Isa, &LaneRecords, &SurfaceLanes, u32, &LightMethods, &mut [f32; WIDTH]),
 }
 
 impl LaneKernel {
@@ -862,32 +867,24 @@ impl LightSet {
         sel.pmf(ctx, light) * self.lights[light].pdf(ctx, at, m)
     }
 
-    /// [`Self::pdf`] for the lanes of `active` (0 in the others): lane i's point on light
-    /// `light[i]`, each light's pdf taken over the lanes that hit it, the selection pmf after
-    /// it in the scalar order (pmf · pdf).
-    pub fn pdf_packet(
+    /// Each light's own pdf ([`Light::pdf_lanes`], no selection pmf) of the lanes of `active`
+    /// that hit it, lane i's point on light `light[i]`, into `out` (other lanes are kept).
+    pub fn pdf_lanes_by_light(
         &self,
         isa: Isa,
-        sel: &dyn LightSelector,
         light: &[u32; WIDTH],
         at: &SurfaceLanes,
         active: u32,
         m: &LightMethods,
-    ) -> [f32; WIDTH] {
-        let mut pdf = [0.0f32; WIDTH];
+        out: &mut [f32; WIDTH],
+    ) {
         let mut rest = active;
         while rest != 0 {
             let i = light[rest.trailing_zeros() as usize];
             let mask = lanes_holding(light, i) & active;
             rest &= !mask;
-            self.lights[i as usize].pdf_lanes(isa, at, mask, m, &mut pdf);
+            self.lights[i as usize].pdf_lanes(isa, at, mask, m, out);
         }
-        for (lane, o) in pdf.iter_mut().enumerate() {
-            if active >> lane & 1 != 0 {
-                *o *= sel.pmf(&at.from.ctx(lane), light[lane] as usize);
-            }
-        }
-        pdf
     }
 
     /// The pdf with which [`Self::sample`] produces direction `wi` towards the environment;
@@ -1042,6 +1039,54 @@ pub(crate) mod lane_tests {
                 );
             }
         }
+    }
+
+    /// Where the pdf kernel over records ([`LaneKernel::pdf`]) leaves [`Light::pdf`] of lane
+    /// i's light `lights[i]` at `at`'s lane i, on some ISA, for a lane of `active`, or where
+    /// it writes a lane outside `active`; None where it is the scalar pdf bit for bit on every
+    /// ISA. The records are the lights' own ([`Light::lane_record`]), then changed by `alter`
+    /// (identity but for a negative control).
+    pub(crate) fn record_pdf_mismatch<T: Light>(
+        lights: &[T],
+        at: &SurfaceLanes,
+        active: u32,
+        m: &LightMethods,
+        alter: impl Fn(&mut LaneRecords),
+    ) -> Option<String> {
+        const MARKER: f32 = -3.5;
+        assert_eq!(lights.len(), WIDTH);
+        let mut records: LaneRecords = [[0.0; WIDTH]; LANE_RECORD];
+        let mut kernel: Option<&'static LaneKernel> = None;
+        for (lane, light) in lights.iter().enumerate() {
+            let (k, r) = light.lane_record(m).expect("a light with a kernel");
+            assert!(kernel.is_none_or(|o| o.is(k)), "one kernel for every lane");
+            kernel = Some(k);
+            for (row, v) in records.iter_mut().zip(r) {
+                row[lane] = v;
+            }
+        }
+        alter(&mut records);
+        let kernel = kernel.expect("sixteen lanes");
+        for isa in Isa::available() {
+            let mut out = [MARKER; WIDTH];
+            (kernel.pdf)(isa, &records, at, active, m, &mut out);
+            for (lane, got) in out.iter().enumerate() {
+                let want = if active >> lane & 1 != 0 {
+                    let (ctx, hit) = at.get(lane);
+                    lights[lane].pdf(&ctx, hit, m)
+                } else {
+                    MARKER
+                };
+                if got.to_bits() != want.to_bits() {
+                    return Some(format!(
+                        "{isa:?} lane {lane}: {got} against {want}, p {:?}, q {:?}",
+                        at.from.p.get(lane),
+                        at.q.get(lane)
+                    ));
+                }
+            }
+        }
+        None
     }
 
     /// `light.pdf_lanes` of lanes `active` equals `light.pdf` lane by lane, bit for bit, on

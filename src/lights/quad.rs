@@ -119,37 +119,6 @@ impl QuadLight {
         })
     }
 
-    /// [`Self::pdf_area`] of every lane of `at`, the same operations in the same order (lanes
-    /// whose point is their viewpoint, which no hit is, hold values that mean nothing).
-    #[inline(always)]
-    fn pdf_area_lanes<V: Vector<WIDTH>>(&self, at: &SurfaceLanes) -> V {
-        let zero = V::splat(0.0);
-        let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
-        let d2 = d.dot(d);
-        let cos_l = V3::splat(self.normal).dot(d).neg().div(d2.sqrt());
-        zero.lt_select(cos_l, d2.div(V::splat(self.area).mul(cos_l)), zero)
-    }
-
-    /// [`Self::pdf_solid_angle`] for the lanes of `a`, bit for bit; other lanes of `out` are
-    /// kept.
-    #[inline(always)]
-    fn pdf_solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
-        &self,
-        at: &SurfaceLanes,
-        a: u32,
-        out: &mut [f32; WIDTH],
-    ) {
-        let zero = V::splat(0.0);
-        let (rect, faces, solid) = rect_lanes::<V, D>(self, V3::load(&at.from.p), a);
-        let mut pdf = V::select(solid, f32s::<V, D>(D::splat(1.0).div(rect.area())), zero);
-        // Tiny rectangles were sampled by area (rare: only then is that pdf computed).
-        let by_area = faces & !solid;
-        if by_area != 0 {
-            pdf = V::select(by_area, self.pdf_area_lanes::<V>(at), pdf);
-        }
-        V::select(a, pdf, V::load(out)).store(out);
-    }
-
     pub fn pdf_solid_angle(&self, p: Vec3, q: Vec3) -> f32 {
         if !self.faces(p) {
             return 0.0;
@@ -348,12 +317,76 @@ fn rect_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     (rect, faces, solid)
 }
 
+/// [`QuadLight::pdf_area`] of every lane of `at`, the same operations in the same order (lanes
+/// whose point is their viewpoint, which no hit is, hold values that mean nothing).
+#[inline(always)]
+fn pdf_area_lanes<V: Vector<WIDTH>>(s: &impl QuadLanes, at: &SurfaceLanes) -> V {
+    let zero = V::splat(0.0);
+    let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
+    let d2 = d.dot(d);
+    let cos_l = s.normal::<V>().dot(d).neg().div(d2.sqrt());
+    zero.lt_select(cos_l, d2.div(s.area::<V>().mul(cos_l)), zero)
+}
+
+/// [`QuadLight::pdf_solid_angle`] of the lanes of `a` (other lanes hold values that mean
+/// nothing).
+#[inline(always)]
+fn pdf_solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+    s: &impl QuadLanes,
+    at: &SurfaceLanes,
+    a: u32,
+) -> V {
+    let zero = V::splat(0.0);
+    let (rect, faces, solid) = rect_lanes::<V, D>(s, V3::load(&at.from.p), a);
+    let pdf = V::select(solid, f32s::<V, D>(D::splat(1.0).div(rect.area())), zero);
+    // Tiny rectangles were sampled by area (rare: only then is that pdf computed).
+    let by_area = faces & !solid;
+    if by_area == 0 {
+        return pdf;
+    }
+    V::select(by_area, pdf_area_lanes::<V>(s, at), pdf)
+}
+
 /// Quads sampled over lanes of different quads (each lane's quad in a record), by the
 /// method `m` picks: by area, or in the solid angle.
 static QUAD_LANES: LaneKernel = LaneKernel {
     name: "quads",
     sample: sample_quad_records,
+    pdf: pdf_quad_records,
 };
+
+fn pdf_quad_records(
+    isa: Isa,
+    records: &LaneRecords,
+    at: &SurfaceLanes,
+    active: u32,
+    m: &LightMethods,
+    out: &mut [f32; WIDTH],
+) {
+    simd::run(isa, QuadPdf(records, at, active, m.quad, out))
+}
+
+/// The pdfs of lanes `.2` of `.1` by method `.3` on quads `.0` (constants or records), into
+/// `.4` (other lanes kept).
+struct QuadPdf<'a, S>(
+    &'a S,
+    &'a SurfaceLanes,
+    u32,
+    QuadMethod,
+    &'a mut [f32; WIDTH],
+);
+
+impl<S: QuadLanes> Kernel for QuadPdf<'_, S> {
+    type Out = ();
+    #[inline(always)]
+    fn run<L: Lanes>(self) {
+        let pdf = match self.3 {
+            QuadMethod::Area => pdf_area_lanes::<L::V>(self.0, self.1),
+            QuadMethod::SolidAngle => pdf_solid_angle_lanes::<L::V, L::D>(self.0, self.1, self.2),
+        };
+        L::V::select(self.2, pdf, L::V::load(self.4)).store(self.4)
+    }
+}
 
 fn sample_quad_records(
     isa: Isa,
@@ -456,28 +489,7 @@ impl Light for QuadLight {
         m: &LightMethods,
         out: &mut [f32; WIDTH],
     ) {
-        struct Area<'a>(&'a QuadLight, &'a SurfaceLanes, u32, &'a mut [f32; WIDTH]);
-        impl Kernel for Area<'_> {
-            type Out = ();
-            #[inline(always)]
-            fn run<L: Lanes>(self) {
-                let pdf = self.0.pdf_area_lanes::<L::V>(self.1);
-                L::V::select(self.2, pdf, L::V::load(self.3)).store(self.3)
-            }
-        }
-        struct SolidAngle<'a>(&'a QuadLight, &'a SurfaceLanes, u32, &'a mut [f32; WIDTH]);
-        impl Kernel for SolidAngle<'_> {
-            type Out = ();
-            #[inline(always)]
-            fn run<L: Lanes>(self) {
-                self.0
-                    .pdf_solid_angle_lanes::<L::V, L::D>(self.1, self.2, self.3)
-            }
-        }
-        match m.quad {
-            QuadMethod::Area => simd::run(isa, Area(self, at, active, out)),
-            QuadMethod::SolidAngle => simd::run(isa, SolidAngle(self, at, active, out)),
-        }
+        simd::run(isa, QuadPdf(self, at, active, m.quad, out))
     }
 
     fn usable_methods(&self, mut m: LightMethods) -> LightMethods {
@@ -646,6 +658,80 @@ mod tests {
             lane_tests::assert_lanes_are_the_scalar_samples(&light, &q.query(), active, &m, &label);
         }
         assert!(kinds.iter().all(|&k| k > 400), "{kinds:?}");
+    }
+
+    /// Where the pdf kernel over records leaves [`QuadLight::pdf`] lane by lane on some ISA,
+    /// for method `method`: sixteen quads per call ([`tilted`] moved and scaled lane by lane),
+    /// seen from [`viewpoint`]s of every kind at points on each quad, corners and edges among
+    /// them; the records changed by `alter`.
+    fn pdf_records_mismatch(
+        method: QuadMethod,
+        alter: impl Fn(&mut LaneRecords),
+    ) -> Option<String> {
+        let m = LightMethods {
+            quad: method,
+            ..LightMethods::BASIC
+        };
+        let mut rng = SampleStream::new(8, 2, 6, 4);
+        let mut kinds = [0usize; 3];
+        for round in 0..300 {
+            let mut at = SurfaceLanes::default();
+            let mut lights = Vec::new();
+            for lane in 0..WIDTH {
+                let t = tilted();
+                let [a, b] = rng.next_2d();
+                let scale = 0.25 + 2.0 * a;
+                let light = QuadLight::new(
+                    t.corner + Vec3::new(b - 0.5, a, 0.5 * b),
+                    t.edge_u * scale,
+                    t.edge_v * scale,
+                    t.radiance,
+                );
+                let p = viewpoint(&light, lane + round, &mut rng);
+                let [s, t] = match lane % 4 {
+                    0 => [0.0, 0.0],
+                    1 => [1.0, rng.next_1d()],
+                    _ => rng.next_2d(),
+                };
+                let q = light.corner + light.edge_u * s + light.edge_v * t;
+                let ctx = LightCtx {
+                    p,
+                    n: -light.normal,
+                };
+                at.set(lane, &ctx, q, 0);
+                kinds[kind_of(&light, p)] += 1;
+                lights.push(light);
+            }
+            let active = lane_tests::active_lanes(round, &mut rng);
+            if let Some(e) = lane_tests::record_pdf_mismatch(&lights, &at, active, &m, &alter) {
+                return Some(format!("{method:?} round {round}: {e}"));
+            }
+        }
+        assert!(kinds.iter().all(|&k| k > 600), "{kinds:?}");
+        None
+    }
+
+    /// Both methods' pdfs over records (lanes that hit different quads of a city's lamps and
+    /// windows) are the scalar ones, bit for bit, on every ISA.
+    #[test]
+    fn pdfs_over_records_are_the_scalar_pdfs() {
+        for method in QuadMethod::ALL {
+            assert_eq!(pdf_records_mismatch(method, |_| ()), None);
+        }
+    }
+
+    /// Controls: a record's area 1 % off is caught by area, its corner moved by 1 % of an
+    /// edge in the solid angle.
+    #[test]
+    fn a_pdf_record_off_is_caught() {
+        let area = pdf_records_mismatch(QuadMethod::Area, |r| r[12] = r[12].map(|a| a * 0.99));
+        assert!(area.is_some());
+        let moved = pdf_records_mismatch(QuadMethod::SolidAngle, |r| {
+            for k in 0..3 {
+                r[k] = std::array::from_fn(|lane| r[k][lane] + 0.01 * r[3 + k][lane]);
+            }
+        });
+        assert!(moved.is_some());
     }
 
     /// Both methods' pdfs over lanes ([`Light::pdf_lanes`], the MIS weight of emission probes

@@ -483,41 +483,15 @@ impl<'s> BoundLights<'s> {
                 .selector
                 .sample_lanes(&q, &numbers, packet.mask, light, &mut x.pmf);
         }
-        // Lights with a kernel over lanes of different lights (mesh triangles, spheres, quads) hand
-        // over their records; each such kernel samples all its lanes at once. One light for
-        // every lane samples them itself below ([`Light::sample_lanes`], its parameters
+        // Lights with a kernel over lanes of different lights (mesh triangles, spheres, quads)
+        // hand over their records; each such kernel samples all its lanes at once. One light
+        // for every lane samples them itself below ([`Light::sample_lanes`], its parameters
         // constants).
-        let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
-        // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
-        // mesh_light `light` pass); lanes without a kernel get the zero record, which no kernel
-        // reads (each samples only its own lanes).
-        let mut with_kernel = 0u32;
-        let mut rows = [&LaneRecord::ZERO; LANES];
-        let mut rest = if constant.is_some() { 0 } else { chosen };
-        while rest != 0 {
-            let lane = rest.trailing_zeros() as usize;
-            rest &= rest - 1;
-            if let Some(k) = self.kernels[light[lane]] {
-                rows[lane] = &self.records[light[lane]];
-                kernels[lane] = Some(k);
-                with_kernel |= 1 << lane;
-            }
-        }
-        if with_kernel != 0 {
-            gather_records(self.isa, &rows, records);
-        }
-        let mut rest = with_kernel;
-        while rest != 0 {
-            let k = kernels[rest.trailing_zeros() as usize].expect("a lane with a kernel");
-            let mut mask = 0;
-            for (lane, other) in kernels.iter().enumerate() {
-                if other.is_some_and(|o| o.is(k)) {
-                    mask |= 1 << lane;
-                }
-            }
-            rest &= !mask;
-            (k.sample)(self.isa, records, &q, mask, &self.methods, ls);
-        }
+        let by_records = if constant.is_some() { 0 } else { chosen };
+        let (with_kernel, kernels) = self.gather_kernel_lanes(light, by_records, records);
+        for_each_kernel(&kernels, with_kernel, |k, mask| {
+            (k.sample)(self.isa, records, &q, mask, &self.methods, ls)
+        });
         // Each other chosen light samples its lanes at once.
         let mut rest = chosen & !with_kernel;
         while rest != 0 {
@@ -557,10 +531,68 @@ impl<'s> BoundLights<'s> {
     }
 
     /// [`Self::pdf`] of the lanes of `active`, lane i's point `at.q[i]` on light `light[i]`
-    /// (0 in other lanes): each light's pdf over the lanes that hit it.
+    /// (0 in other lanes), bit for bit: lanes whose lights answer a kernel over records (an
+    /// emissive mesh's triangles, each lane its own) through it, all at once; each other
+    /// light over the lanes that hit it; then each lane's selection pmf, in the scalar order
+    /// (pmf · pdf).
     pub fn pdf_packet(&self, light: &[u32; LANES], at: &SurfaceLanes, active: u32) -> [f32; LANES] {
-        self.lights
-            .pdf_packet(self.isa, self.selector, light, at, active, &self.methods)
+        let mut pdf = [0.0f32; LANES];
+        let mut with_kernel = 0;
+        // As in sampling: where one light serves every lane, it takes them all itself.
+        if self.selector.constant().is_none() {
+            let lights = light.map(|i| i as usize);
+            let mut records = [[0.0; WIDTH]; LANE_RECORD];
+            let kernels;
+            (with_kernel, kernels) = self.gather_kernel_lanes(&lights, active, &mut records);
+            for_each_kernel(&kernels, with_kernel, |k, mask| {
+                (k.pdf)(self.isa, &records, at, mask, &self.methods, &mut pdf)
+            });
+        }
+        self.lights.pdf_lanes_by_light(
+            self.isa,
+            light,
+            at,
+            active & !with_kernel,
+            &self.methods,
+            &mut pdf,
+        );
+        for (lane, o) in pdf.iter_mut().enumerate() {
+            if active >> lane & 1 != 0 {
+                *o *= self.selector.pmf(&at.from.ctx(lane), light[lane] as usize);
+            }
+        }
+        pdf
+    }
+
+    /// The lanes of `lanes` whose lights answer a kernel over records ([`Light::lane_record`]),
+    /// with each such lane's kernel; their records gathered into `records` (other lanes get
+    /// the zero record, which no kernel reads: each runs only its own lanes).
+    #[inline(always)]
+    fn gather_kernel_lanes(
+        &self,
+        light: &[usize; LANES],
+        lanes: u32,
+        records: &mut LaneRecords,
+    ) -> (u32, [Option<&'static LaneKernel>; LANES]) {
+        let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
+        // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
+        // mesh_light `light` pass).
+        let mut with_kernel = 0u32;
+        let mut rows = [&LaneRecord::ZERO; LANES];
+        let mut rest = lanes;
+        while rest != 0 {
+            let lane = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            if let Some(k) = self.kernels[light[lane]] {
+                rows[lane] = &self.records[light[lane]];
+                kernels[lane] = Some(k);
+                with_kernel |= 1 << lane;
+            }
+        }
+        if with_kernel != 0 {
+            gather_records(self.isa, &rows, records);
+        }
+        (with_kernel, kernels)
     }
 
     /// The pdf with which [`Self::probe`] samples direction `wi` towards the environment.
@@ -587,6 +619,28 @@ impl<'s> BoundLights<'s> {
             }
         }
         out
+    }
+}
+
+/// `f(kernel, lanes)` once per kernel among `kernels`' lanes `with_kernel`, with the lanes
+/// that answer it (kernels are told apart by address, [`LaneKernel::is`]).
+#[inline(always)]
+fn for_each_kernel(
+    kernels: &[Option<&'static LaneKernel>; LANES],
+    with_kernel: u32,
+    mut f: impl FnMut(&'static LaneKernel, u32),
+) {
+    let mut rest = with_kernel;
+    while rest != 0 {
+        let k = kernels[rest.trailing_zeros() as usize].expect("a lane with a kernel");
+        let mut mask = 0;
+        for (lane, other) in kernels.iter().enumerate() {
+            if other.is_some_and(|o| o.is(k)) {
+                mask |= 1 << lane;
+            }
+        }
+        rest &= !mask;
+        f(k, mask);
     }
 }
 
