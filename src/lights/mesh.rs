@@ -10,8 +10,8 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
-    LightMethods, LightSample, LightShape, MeshMethod, SurfaceLanes, d64, direction_to, f32s, keep,
-    record_rows, record_rows_d,
+    LightMethods, LightSample, LightShape, MIN_PDF_KERNEL_LANES, MeshMethod, SurfaceLanes, d64,
+    direction_to, f32s, keep, record_rows, record_rows_d,
 };
 use crate::geometry::triangle::Triangle;
 use crate::math::gamma;
@@ -362,7 +362,8 @@ impl Light for TriangleLight {
         }
     }
 
-    /// Through its kernel over records, this triangle's record in every lane.
+    /// Through its kernel over records, this triangle's record in every lane, where
+    /// [`MIN_PDF_KERNEL_LANES`] lanes or more hit it; fewer one at a time.
     fn pdf_lanes(
         &self,
         isa: Isa,
@@ -372,8 +373,10 @@ impl Light for TriangleLight {
         out: &mut [f32; WIDTH],
     ) {
         match self.lane_record(m) {
-            Some((k, r)) => (k.pdf)(isa, &r.map(|v| [v; WIDTH]), at, active, m, out),
-            None => super::pdf_lane_by_lane(self, at, active, m, out),
+            Some((k, r)) if active.count_ones() >= MIN_PDF_KERNEL_LANES => {
+                (k.pdf)(isa, &r.map(|v| [v; WIDTH]), at, active, m, out)
+            }
+            _ => super::pdf_lane_by_lane(self, at, active, m, out),
         }
     }
 

@@ -477,6 +477,13 @@ pub(crate) fn record_rows_d<D: Vector64<WIDTH>>(r: &LaneRecords, k: usize) -> [D
     ]
 }
 
+/// The fewest lanes a pdf kernel over lanes ([`LaneKernel::pdf`], a triangle's
+/// [`Light::pdf_lanes`]) is run for; fewer are taken one at a time. Its f64 spherical triangle
+/// over 16 lanes, with the records' gather, executes about as many instructions as five lanes'
+/// scalar pdfs on AVX2 (3,600 against 755 a lane; `scripts/instructions.sh` on many_mesh and
+/// mesh_light, docs/tracer.md, stop 56), whatever the number of lanes it has to answer.
+pub const MIN_PDF_KERNEL_LANES: u32 = 5;
+
 /// A kernel that samples the lanes of a packet together although each lane has its own light
 /// of one type (mesh triangles: every lane picks its own triangle, so sampling per light,
 /// [`Light::sample_lanes`], would run one lane at a time). Each light hands over its

@@ -13,8 +13,8 @@ use crate::env::EnvMethod;
 use crate::geometry::Ray;
 use crate::lights::selector::{LightSelector, SelectorType, default_selector};
 use crate::lights::{
-    LANE_RECORD, LaneKernel, LaneQuery, LaneRecord, LaneRecords, LaneSamples, SHADOW_EPSILON,
-    gather_records, selection_numbers,
+    LANE_RECORD, LaneKernel, LaneQuery, LaneRecord, LaneRecords, LaneSamples, MIN_PDF_KERNEL_LANES,
+    SHADOW_EPSILON, gather_records, selection_numbers,
 };
 use crate::lights::{
     LightHit, LightMethods, LightSample, LightSet, LightShape, MethodOverride, SurfaceLanes,
@@ -488,9 +488,13 @@ impl<'s> BoundLights<'s> {
         // for every lane samples them itself below ([`Light::sample_lanes`], its parameters
         // constants).
         let by_records = if constant.is_some() { 0 } else { chosen };
-        let (with_kernel, kernels) = self.gather_kernel_lanes(light, by_records, records);
-        for_each_kernel(&kernels, with_kernel, |k, mask| {
-            (k.sample)(self.isa, records, &q, mask, &self.methods, ls)
+        let k = self.kernel_lanes(light, by_records);
+        let with_kernel = k.mask;
+        if with_kernel != 0 {
+            gather_records(self.isa, &k.rows, records);
+        }
+        for_each_kernel(&k.kernels, with_kernel, |kernel, mask| {
+            (kernel.sample)(self.isa, records, &q, mask, &self.methods, ls)
         });
         // Each other chosen light samples its lanes at once.
         let mut rest = chosen & !with_kernel;
@@ -538,15 +542,19 @@ impl<'s> BoundLights<'s> {
     pub fn pdf_packet(&self, light: &[u32; LANES], at: &SurfaceLanes, active: u32) -> [f32; LANES] {
         let mut pdf = [0.0f32; LANES];
         let mut with_kernel = 0;
-        // As in sampling: where one light serves every lane, it takes them all itself.
-        if self.selector.constant().is_none() {
-            let lights = light.map(|i| i as usize);
-            let mut records = [[0.0; WIDTH]; LANE_RECORD];
-            let kernels;
-            (with_kernel, kernels) = self.gather_kernel_lanes(&lights, active, &mut records);
-            for_each_kernel(&kernels, with_kernel, |k, mask| {
-                (k.pdf)(self.isa, &records, at, mask, &self.methods, &mut pdf)
-            });
+        // Where every lane hit one light, it takes them all itself, its parameters constants
+        // (no records to gather).
+        let first = light[active.trailing_zeros() as usize % LANES];
+        if lanes_holding(light, first) & active != active {
+            let k = self.kernel_lanes(&light.map(|i| i as usize), active);
+            if k.mask.count_ones() >= MIN_PDF_KERNEL_LANES {
+                with_kernel = k.mask;
+                let mut records = [[0.0; WIDTH]; LANE_RECORD];
+                gather_records(self.isa, &k.rows, &mut records);
+                for_each_kernel(&k.kernels, k.mask, |kernel, mask| {
+                    (kernel.pdf)(self.isa, &records, at, mask, &self.methods, &mut pdf)
+                });
+            }
         }
         self.lights.pdf_lanes_by_light(
             self.isa,
@@ -565,34 +573,28 @@ impl<'s> BoundLights<'s> {
     }
 
     /// The lanes of `lanes` whose lights answer a kernel over records ([`Light::lane_record`]),
-    /// with each such lane's kernel; their records gathered into `records` (other lanes get
-    /// the zero record, which no kernel reads: each runs only its own lanes).
+    /// with each such lane's kernel and record (other lanes get the zero record, which no
+    /// kernel reads: each runs only its own lanes).
     #[inline(always)]
-    fn gather_kernel_lanes(
-        &self,
-        light: &[usize; LANES],
-        lanes: u32,
-        records: &mut LaneRecords,
-    ) -> (u32, [Option<&'static LaneKernel>; LANES]) {
-        let mut kernels: [Option<&'static LaneKernel>; LANES] = [None; LANES];
-        // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
-        // mesh_light `light` pass).
-        let mut with_kernel = 0u32;
-        let mut rows = [&LaneRecord::ZERO; LANES];
+    fn kernel_lanes(&self, light: &[usize; LANES], lanes: u32) -> KernelLanes<'_> {
+        let mut k = KernelLanes {
+            mask: 0,
+            kernels: [None; LANES],
+            // The caller's rows (a heap record was a malloc and a free per packet: 2.4 % of a
+            // mesh_light `light` pass).
+            rows: [&LaneRecord::ZERO; LANES],
+        };
         let mut rest = lanes;
         while rest != 0 {
             let lane = rest.trailing_zeros() as usize;
             rest &= rest - 1;
-            if let Some(k) = self.kernels[light[lane]] {
-                rows[lane] = &self.records[light[lane]];
-                kernels[lane] = Some(k);
-                with_kernel |= 1 << lane;
+            if let Some(kernel) = self.kernels[light[lane]] {
+                k.rows[lane] = &self.records[light[lane]];
+                k.kernels[lane] = Some(kernel);
+                k.mask |= 1 << lane;
             }
         }
-        if with_kernel != 0 {
-            gather_records(self.isa, &rows, records);
-        }
-        (with_kernel, kernels)
+        k
     }
 
     /// The pdf with which [`Self::probe`] samples direction `wi` towards the environment.
@@ -620,6 +622,14 @@ impl<'s> BoundLights<'s> {
         }
         out
     }
+}
+
+/// What [`BoundLights::kernel_lanes`] finds: the lanes whose lights have a kernel over records
+/// (`mask`), each one's kernel, and each one's record (to gather).
+struct KernelLanes<'a> {
+    mask: u32,
+    kernels: [Option<&'static LaneKernel>; LANES],
+    rows: [&'a LaneRecord; LANES],
 }
 
 /// `f(kernel, lanes)` once per kernel among `kernels`' lanes `with_kernel`, with the lanes
