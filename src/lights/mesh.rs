@@ -236,17 +236,12 @@ fn pdf_solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     at: &SurfaceLanes,
     a: u32,
 ) -> V {
-    let p = V3::<V>::load(&at.from.p);
-    let v0 = record_rows::<V>(r, 0);
-    let zero = V::splat(0.0);
-    let faces = a & zero.lt((p - v0).dot(record_rows::<V>(r, 9)));
-    let ta = unit_from::<V, D>(v0, p);
-    let tb = unit_from::<V, D>(record_rows::<V>(r, 3), p);
-    let tc = unit_from::<V, D>(record_rows::<V>(r, 6), p);
-    let big = !triangle_solid_angle_lanes(ta, tb, tc).lt(D::splat(MIN_SOLID_ANGLE));
-    let (st, ok) = SphericalTriangle::<D>::lanes(ta, tb, tc);
-    let solid = faces & big & ok;
-    let pdf = V::select(solid, f32s::<V, D>(D::splat(1.0).div(st.area())), zero);
+    let (st, faces, solid) = spherical_lanes::<V, D>(r, V3::load(&at.from.p), a);
+    let pdf = V::select(
+        solid,
+        f32s::<V, D>(D::splat(1.0).div(st.area())),
+        V::splat(0.0),
+    );
     // Tiny triangles were sampled by area (rare: only then is that pdf computed).
     let by_area = faces & !solid;
     if by_area == 0 {
@@ -266,23 +261,15 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     out: &mut LaneSamples,
 ) {
     let p = V3::<V>::load(q.p);
-    let v0 = record_rows::<V>(r, 0);
-    let normal = record_rows::<V>(r, 9);
-    let faces = a & V::splat(0.0).lt((p - v0).dot(normal));
-    // Each vertex relative to p, rounded in f32, then widened and normalised.
-    let ta = unit_from::<V, D>(v0, p);
-    let tb = unit_from::<V, D>(record_rows::<V>(r, 3), p);
-    let tc = unit_from::<V, D>(record_rows::<V>(r, 6), p);
-    let big = !triangle_solid_angle_lanes(ta, tb, tc).lt(D::splat(MIN_SOLID_ANGLE));
-    let (st, ok) = SphericalTriangle::<D>::lanes(ta, tb, tc);
-    let solid = faces & big & ok;
+    let (st, faces, solid) = spherical_lanes::<V, D>(r, p, a);
     let w = st.sample_lanes(D::from_f32(q.u[0]), D::from_f32(q.u[1]));
     // Where the direction meets the triangle's plane; none where it grazes it.
     let n = record_rows_d::<D>(r, 9);
     let cos = dot3(w, n);
     let zero = D::splat(0.0);
     let hits = solid & !zero.le(cos);
-    let rel = v0 - p;
+    let normal = record_rows::<V>(r, 9);
+    let rel = record_rows::<V>(r, 0) - p;
     let rel = [d64::<V, D>(rel.x), d64::<V, D>(rel.y), d64::<V, D>(rel.z)];
     let dist = dot3(rel, n).div(D::select(hits, cos, D::splat(-1.0)));
     let wd = scale3(w, dist);
@@ -308,6 +295,27 @@ fn solid_angle_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     out.distant &= !a;
     // Tiny triangles are sampled by area.
     area_lanes::<V>(r, q, faces & !solid, out);
+}
+
+/// Each lane's triangle seen from p as a spherical triangle (f64 lanes), the lanes of `a`
+/// that see its front, and those of them it is sampled in the solid angle from (the others
+/// fall back to area sampling: too small, or no spherical triangle) — the decisions of
+/// [`TriangleLight::sample_solid_angle`] and [`TriangleLight::pdf_solid_angle`].
+#[inline(always)]
+fn spherical_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
+    r: &LaneRecords,
+    p: V3<V>,
+    a: u32,
+) -> (SphericalTriangle<D>, u32, u32) {
+    let v0 = record_rows::<V>(r, 0);
+    let faces = a & V::splat(0.0).lt((p - v0).dot(record_rows::<V>(r, 9)));
+    // Each vertex relative to p, rounded in f32, then widened and normalised.
+    let ta = unit_from::<V, D>(v0, p);
+    let tb = unit_from::<V, D>(record_rows::<V>(r, 3), p);
+    let tc = unit_from::<V, D>(record_rows::<V>(r, 6), p);
+    let big = !triangle_solid_angle_lanes(ta, tb, tc).lt(D::splat(MIN_SOLID_ANGLE));
+    let (st, ok) = SphericalTriangle::<D>::lanes(ta, tb, tc);
+    (st, faces, faces & big & ok)
 }
 
 /// (v − p) rounded in f32, widened exactly to f64 and normalised.
