@@ -11,7 +11,7 @@ use super::bounds::{Bounds, LightBounds};
 use super::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
     LightMethods, LightSample, LightShape, MIN_PDF_KERNEL_LANES, MeshMethod, SurfaceLanes, d64,
-    direction_to, f32s, keep, record_rows, record_rows_d,
+    direction_to, f32s, flat_area_pdf_lanes, keep, record_rows, record_rows_d,
 };
 use crate::geometry::triangle::Triangle;
 use crate::math::gamma;
@@ -216,15 +216,10 @@ fn pdf_triangle_records(
     simd::run(isa, Kernel(records, at, active, m.mesh, out))
 }
 
-/// [`TriangleLight::pdf_area`] of every lane, the same operations in the same order (lanes
-/// whose point is their viewpoint, which no hit is, hold values that mean nothing).
+/// [`TriangleLight::pdf_area`] of every lane.
 #[inline(always)]
 fn pdf_area_lanes<V: Vector<WIDTH>>(r: &LaneRecords, at: &SurfaceLanes) -> V {
-    let zero = V::splat(0.0);
-    let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
-    let d2 = d.dot(d);
-    let cos_l = record_rows::<V>(r, 9).dot(d).neg().div(d2.sqrt());
-    zero.lt_select(cos_l, d2.div(V::load(&r[12]).mul(cos_l)), zero)
+    flat_area_pdf_lanes(record_rows::<V>(r, 9), V::load(&r[12]), at)
 }
 
 /// [`TriangleLight::pdf_solid_angle`] of the lanes of `a`: the spherical triangle of

@@ -399,6 +399,24 @@ pub(crate) fn keep<V: Vector<WIDTH>>(m: u32, new: V3<V>, old: &mut Soa3) {
     V3::select(m, new, V3::load(old)).store(old)
 }
 
+/// The solid-angle pdf of a point uniform by area on a flat light (unit normal `normal`, area
+/// `area`) at each lane of `at`: d²/(A·cos θ_l) where the light faces the viewpoint, 0
+/// elsewhere; the scalar `pdf_area` of quads and mesh triangles, the same operations in the
+/// same order. Lanes whose point is their viewpoint (which no hit is) hold values that mean
+/// nothing.
+#[inline(always)]
+pub(crate) fn flat_area_pdf_lanes<V: Vector<WIDTH>>(
+    normal: V3<V>,
+    area: V,
+    at: &SurfaceLanes,
+) -> V {
+    let zero = V::splat(0.0);
+    let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
+    let d2 = d.dot(d);
+    let cos_l = normal.dot(d).neg().div(d2.sqrt());
+    zero.lt_select(cos_l, d2.div(area.mul(cos_l)), zero)
+}
+
 /// f64 lanes rounded to f32 lanes. A function, not a closure: a closure is not always inlined
 /// into the ISA's entry, and outside it its vector operations are calls.
 #[inline(always)]

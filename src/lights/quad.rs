@@ -5,8 +5,8 @@
 use super::bounds::{Bounds, LightBounds};
 use super::{
     LANE_RECORD, LaneKernel, LaneQuery, LaneRecords, LaneSamples, Light, LightCtx, LightHit,
-    LightMethods, LightSample, LightShape, QuadMethod, SurfaceLanes, d64, direction_to, f32s, keep,
-    record_rows, record_rows_d,
+    LightMethods, LightSample, LightShape, QuadMethod, SurfaceLanes, d64, direction_to, f32s,
+    flat_area_pdf_lanes, keep, record_rows, record_rows_d,
 };
 use crate::math::gamma;
 use crate::math::luminance;
@@ -317,15 +317,10 @@ fn rect_lanes<V: Vector<WIDTH>, D: Vector64<WIDTH>>(
     (rect, faces, solid)
 }
 
-/// [`QuadLight::pdf_area`] of every lane of `at`, the same operations in the same order (lanes
-/// whose point is their viewpoint, which no hit is, hold values that mean nothing).
+/// [`QuadLight::pdf_area`] of every lane of `at`.
 #[inline(always)]
 fn pdf_area_lanes<V: Vector<WIDTH>>(s: &impl QuadLanes, at: &SurfaceLanes) -> V {
-    let zero = V::splat(0.0);
-    let d = V3::<V>::load(&at.q) - V3::load(&at.from.p);
-    let d2 = d.dot(d);
-    let cos_l = s.normal::<V>().dot(d).neg().div(d2.sqrt());
-    zero.lt_select(cos_l, d2.div(s.area::<V>().mul(cos_l)), zero)
+    flat_area_pdf_lanes(s.normal::<V>(), s.area::<V>(), at)
 }
 
 /// [`QuadLight::pdf_solid_angle`] of the lanes of `a` (other lanes hold values that mean
@@ -622,6 +617,31 @@ mod tests {
         }
     }
 
+    /// Lane `lane` of `at`: a [`viewpoint`] of kind `lane + round` and a point on `light`
+    /// (its corner in every fourth lane, a point on its far edge in the next, else anywhere
+    /// on it); returns the viewpoint's [`kind_of`].
+    fn set_hit(
+        at: &mut SurfaceLanes,
+        lane: usize,
+        round: usize,
+        light: &QuadLight,
+        rng: &mut SampleStream,
+    ) -> usize {
+        let p = viewpoint(light, lane + round, rng);
+        let [s, t] = match lane % 4 {
+            0 => [0.0, 0.0],
+            1 => [1.0, rng.next_1d()],
+            _ => rng.next_2d(),
+        };
+        let q = light.corner + light.edge_u * s + light.edge_v * t;
+        let ctx = LightCtx {
+            p,
+            n: -light.normal,
+        };
+        at.set(lane, &ctx, q, 0);
+        kind_of(light, p)
+    }
+
     /// Which case of the scalar sampler `p` is: no sample, area, solid angle.
     fn kind_of(light: &QuadLight, p: Vec3) -> usize {
         match (light.faces(p), light.spherical_rect(p)) {
@@ -687,19 +707,7 @@ mod tests {
                     t.edge_v * scale,
                     t.radiance,
                 );
-                let p = viewpoint(&light, lane + round, &mut rng);
-                let [s, t] = match lane % 4 {
-                    0 => [0.0, 0.0],
-                    1 => [1.0, rng.next_1d()],
-                    _ => rng.next_2d(),
-                };
-                let q = light.corner + light.edge_u * s + light.edge_v * t;
-                let ctx = LightCtx {
-                    p,
-                    n: -light.normal,
-                };
-                at.set(lane, &ctx, q, 0);
-                kinds[kind_of(&light, p)] += 1;
+                kinds[set_hit(&mut at, lane, round, &light, &mut rng)] += 1;
                 lights.push(light);
             }
             let active = lane_tests::active_lanes(round, &mut rng);
@@ -751,19 +759,7 @@ mod tests {
             for round in 0..400 {
                 let mut at = SurfaceLanes::default();
                 for lane in 0..WIDTH {
-                    let p = viewpoint(&light, lane + round, &mut rng);
-                    let [s, t] = match lane % 4 {
-                        0 => [0.0, 0.0],
-                        1 => [1.0, rng.next_1d()],
-                        _ => rng.next_2d(),
-                    };
-                    let q = light.corner + light.edge_u * s + light.edge_v * t;
-                    let ctx = LightCtx {
-                        p,
-                        n: -light.normal,
-                    };
-                    at.set(lane, &ctx, q, 0);
-                    kinds[kind_of(&light, p)] += 1;
+                    kinds[set_hit(&mut at, lane, round, &light, &mut rng)] += 1;
                 }
                 let active = lane_tests::active_lanes(round, &mut rng);
                 let label = format!("{method:?} round {round}");

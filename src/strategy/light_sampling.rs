@@ -544,8 +544,8 @@ impl<'s> BoundLights<'s> {
         let mut with_kernel = 0;
         // Where every lane hit one light, it takes them all itself, its parameters constants
         // (no records to gather).
-        let first = light[active.trailing_zeros() as usize % LANES];
-        if lanes_holding(light, first) & active != active {
+        let first = active.trailing_zeros() as usize;
+        if active != 0 && lanes_holding(light, light[first]) & active != active {
             let k = self.kernel_lanes(&light.map(|i| i as usize), active);
             if k.mask.count_ones() >= MIN_PDF_KERNEL_LANES {
                 with_kernel = k.mask;
