@@ -35,7 +35,7 @@ pub struct HierarchicalWarp {
 }
 
 /// Four quads in one cache line.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(64))]
 struct Line([[f32; 4]; 4]);
 
@@ -211,13 +211,12 @@ impl HierarchicalWarp {
     }
 }
 
-/// Lane i's quad `q[i]` (quad q % 4 of line q / 4), as four vectors, one per texel of the
-/// quad ([`Vector::load_records`]: each quad read whole, transposed in registers).
+/// Lane i's quad `q[i]` (quad q % 4 of line q / 4, so quad q of the lines read as one flat
+/// table), as four vectors, one per texel of the quad ([`Vector::gather_records`]: each quad
+/// read whole, transposed in registers).
 #[inline(always)]
 fn gather<V: Vector<N>, const N: usize>(lines: &[Line], q: &[u32; N]) -> [V; 4] {
-    V::load_records(&std::array::from_fn(|i| {
-        &lines[q[i] as usize / 4].0[q[i] as usize % 4]
-    }))
+    V::gather_records(bytemuck::cast_slice(lines), q)
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in

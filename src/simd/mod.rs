@@ -102,6 +102,23 @@ pub trait Vector<const N: usize>: Copy {
             Self::load(&a[3]),
         ]
     }
+    /// [`Self::load_records`] of the records `table[idx[i]]`: one bounds check for all the
+    /// lanes (on their largest index) instead of one per lane, and each lane's address taken
+    /// straight from its index. Checked per lane, the 16 compares and branches and the array
+    /// of addresses cost more than the loads (docs/tracer.md, stop 57).
+    #[inline(always)]
+    fn gather_records(table: &[[f32; 4]], idx: &[u32; N]) -> [Self; 4] {
+        let top = idx.iter().fold(0, |m, &i| m.max(i)) as usize;
+        assert!(
+            top < table.len(),
+            "record {top} of a table of {}",
+            table.len()
+        );
+        // SAFETY: every idx[i] ≤ top < table.len().
+        Self::load_records(&std::array::from_fn(|i| unsafe {
+            table.get_unchecked(idx[i] as usize)
+        }))
+    }
 }
 
 /// An f64 vector of `N` lanes, for the sample-path code whose numerics need f64 (sphere cones,
@@ -536,26 +553,40 @@ mod tests {
 
     struct Records<'a>(&'a [[f32; 4]], [usize; WIDTH]);
 
+    /// Each width's records by address ([`Vector::load_records`]) and by index
+    /// ([`Vector::gather_records`]), the narrow ones of the lanes in reverse.
+    type RecordLanes = ([[f32; WIDTH]; 4], [[f32; NARROW]; 4]);
+
     impl Kernel for Records<'_> {
-        type Out = ([[f32; WIDTH]; 4], [[f32; NARROW]; 4]);
+        type Out = [RecordLanes; 2];
         fn run<L: Lanes>(self) -> Self::Out {
             let rows: [&[f32; 4]; WIDTH] = std::array::from_fn(|i| &self.0[self.1[i]]);
             let narrow: [&[f32; 4]; NARROW] = std::array::from_fn(|i| rows[WIDTH - 1 - i]);
-            let (mut w, mut n) = ([[0.0; WIDTH]; 4], [[0.0; NARROW]; 4]);
-            for (k, v) in L::V::load_records(&rows).into_iter().enumerate() {
-                v.store(&mut w[k]);
+            let at: [u32; WIDTH] = self.1.map(|i| i as u32);
+            let narrow_at: [u32; NARROW] = std::array::from_fn(|i| at[WIDTH - 1 - i]);
+            let mut out = [([[0.0; WIDTH]; 4], [[0.0; NARROW]; 4]); 2];
+            let wide = [L::V::load_records(&rows), L::V::gather_records(self.0, &at)];
+            let thin = [
+                L::W::load_records(&narrow),
+                L::W::gather_records(self.0, &narrow_at),
+            ];
+            for (o, (w, n)) in out.iter_mut().zip(wide.into_iter().zip(thin)) {
+                for (k, v) in w.into_iter().enumerate() {
+                    v.store(&mut o.0[k]);
+                }
+                for (k, v) in n.into_iter().enumerate() {
+                    v.store(&mut o.1[k]);
+                }
             }
-            for (k, v) in L::W::load_records(&narrow).into_iter().enumerate() {
-                v.store(&mut n[k]);
-            }
-            (w, n)
+            out
         }
     }
 
     /// Records read over lanes are each lane's record, component by component, at both
-    /// widths on every ISA (lanes reading the same record among them). Control: the scalar
-    /// formula's answer is checked directly, so a transposition that swaps lanes or
-    /// components (the ISAs' shuffles) fails here.
+    /// widths on every ISA (lanes reading the same record among them, one the table's last),
+    /// whether given by address or by index. Control: the scalar formula's answer is checked
+    /// directly, so a transposition that swaps lanes or components (the ISAs' shuffles), or
+    /// an index taken as another lane's, fails here.
     #[test]
     fn records_over_lanes_are_each_lanes_record() {
         let table: Vec<[f32; 4]> = (0..40)
@@ -563,16 +594,45 @@ mod tests {
             .collect();
         let mut at: [usize; WIDTH] = std::array::from_fn(|i| (i * 7 + 3) % 40);
         at[9] = at[2];
+        at[5] = 39;
         for isa in Isa::available() {
-            let (w, n) = run(isa, Records(&table, at));
-            for k in 0..4 {
-                for i in 0..WIDTH {
-                    assert_eq!(w[k][i].to_bits(), table[at[i]][k].to_bits(), "{isa:?}");
+            for (w, n) in run(isa, Records(&table, at)) {
+                for k in 0..4 {
+                    for i in 0..WIDTH {
+                        assert_eq!(w[k][i].to_bits(), table[at[i]][k].to_bits(), "{isa:?}");
+                    }
+                    for i in 0..NARROW {
+                        let want = table[at[WIDTH - 1 - i]][k];
+                        assert_eq!(n[k][i].to_bits(), want.to_bits(), "{isa:?}");
+                    }
                 }
-                for i in 0..NARROW {
-                    let want = table[at[WIDTH - 1 - i]][k];
-                    assert_eq!(n[k][i].to_bits(), want.to_bits(), "{isa:?}");
-                }
+            }
+        }
+    }
+
+    struct Gather<'a>(&'a [[f32; 4]], [u32; WIDTH]);
+
+    impl Kernel for Gather<'_> {
+        type Out = f32;
+        fn run<L: Lanes>(self) -> f32 {
+            L::V::gather_records(self.0, &self.1)[0].reduce_max()
+        }
+    }
+
+    /// An index past the table's end stops `gather_records` (its one check for all lanes
+    /// covers every lane, not only the first or the last), on every ISA; the largest index
+    /// still in the table reads it. Control: the same index one lower is accepted.
+    #[test]
+    fn gathered_records_are_bounds_checked_on_every_lane() {
+        let table = vec![[1.0f32, 2.0, 3.0, 4.0]; 40];
+        for isa in Isa::available() {
+            for lane in [0, 7, 8, WIDTH - 1] {
+                let mut at = [0u32; WIDTH];
+                at[lane] = 39;
+                assert_eq!(run(isa, Gather(&table, at)), 1.0, "{isa:?}: control");
+                at[lane] = 40;
+                let caught = std::panic::catch_unwind(|| run(isa, Gather(&table, at)));
+                assert!(caught.is_err(), "{isa:?}: lane {lane} read past the table");
             }
         }
     }
