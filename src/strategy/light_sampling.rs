@@ -139,22 +139,29 @@ fn shadow_lanes<V: Vector<WIDTH>>(q: &LaneQuery, ls: &LaneSamples, x: &ShadowLan
     let pdf = V::load(&ls.pdf).mul(V::load(&x.pmf));
     let cos = V3::load(q.n).dot(wi);
     let mut valid = ls.valid & !cos.le(zero);
-    let origin = V3::load(&x.geo.origin);
-    let point = V3::load(&ls.point);
-    let normal = V3::load(&ls.normal);
-    let facing = zero.le(normal.dot(origin - point));
-    let towards = V3::select(facing, normal, -normal);
-    let target = offset_ray_origin_lanes(point, V3::load(&ls.point_error), towards);
-    let d = target - origin;
-    let dist = d.dot(d).sqrt();
     let distant = ls.distant;
-    valid &= distant | !dist.eq(zero);
-    let dir = V3::select(distant, wi, d / dist);
-    let tmax = V::select(
-        distant,
-        V::splat(f32::INFINITY),
-        dist.mul(V::splat(1.0 - SHADOW_EPSILON)),
-    );
+    let unbounded = V::splat(f32::INFINITY);
+    // Only the valid lanes' rays are read. Where they are all distant (an environment or a
+    // directional light), none has an end point: the segment below, the end point's offset
+    // and a division by the distance, would be thrown away by the selects.
+    let (dir, tmax) = if valid & !distant == 0 {
+        (wi, unbounded)
+    } else {
+        let origin = V3::load(&x.geo.origin);
+        let point = V3::load(&ls.point);
+        let normal = V3::load(&ls.normal);
+        let facing = zero.le(normal.dot(origin - point));
+        let towards = V3::select(facing, normal, -normal);
+        let target = offset_ray_origin_lanes(point, V3::load(&ls.point_error), towards);
+        let d = target - origin;
+        let dist = d.dot(d).sqrt();
+        valid &= distant | !dist.eq(zero);
+        let tmax = dist.mul(V::splat(1.0 - SHADOW_EPSILON));
+        (
+            V3::select(distant, wi, d / dist),
+            V::select(distant, unbounded, tmax),
+        )
+    };
     let local = V3 {
         x: wi.dot(V3::load(&x.geo.s)),
         y: wi.dot(V3::load(&x.geo.t)),
