@@ -212,11 +212,11 @@ impl HierarchicalWarp {
 }
 
 /// Lane i's quad `q[i]` (quad q % 4 of line q / 4, so quad q of the lines read as one flat
-/// table), as four vectors, one per texel of the quad ([`Vector::gather_records`]: each quad
+/// table), as four vectors, one per texel of the quad ([`Vector::load_records_at`]: each quad
 /// read whole, transposed in registers).
 #[inline(always)]
 fn gather<V: Vector<N>, const N: usize>(lines: &[Line], q: &[u32; N]) -> [V; 4] {
-    V::gather_records(bytemuck::cast_slice(lines), q)
+    V::load_records_at(bytemuck::cast_slice(lines), q)
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in

@@ -108,7 +108,7 @@ pub trait Vector<const N: usize>: Copy {
     /// slot, the gather was 42 % of the environment warp's instructions (docs/tracer.md,
     /// stop 57).
     #[inline(always)]
-    fn gather_records(table: &[[f32; 4]], idx: &[u32; N]) -> [Self; 4] {
+    fn load_records_at(table: &[[f32; 4]], idx: &[u32; N]) -> [Self; 4] {
         let top = idx.iter().fold(0, |m, &i| m.max(i)) as usize;
         assert!(
             top < table.len(),
@@ -555,7 +555,7 @@ mod tests {
     struct Records<'a>(&'a [[f32; 4]], [usize; WIDTH]);
 
     /// Each width's records by address ([`Vector::load_records`]) and by index
-    /// ([`Vector::gather_records`]), the narrow ones of the lanes in reverse.
+    /// ([`Vector::load_records_at`]), the narrow ones of the lanes in reverse.
     type RecordLanes = ([[f32; WIDTH]; 4], [[f32; NARROW]; 4]);
 
     impl Kernel for Records<'_> {
@@ -566,10 +566,13 @@ mod tests {
             let at: [u32; WIDTH] = self.1.map(|i| i as u32);
             let narrow_at: [u32; NARROW] = std::array::from_fn(|i| at[WIDTH - 1 - i]);
             let mut out = [([[0.0; WIDTH]; 4], [[0.0; NARROW]; 4]); 2];
-            let wide = [L::V::load_records(&rows), L::V::gather_records(self.0, &at)];
+            let wide = [
+                L::V::load_records(&rows),
+                L::V::load_records_at(self.0, &at),
+            ];
             let thin = [
                 L::W::load_records(&narrow),
-                L::W::gather_records(self.0, &narrow_at),
+                L::W::load_records_at(self.0, &narrow_at),
             ];
             for (o, (w, n)) in out.iter_mut().zip(wide.into_iter().zip(thin)) {
                 for (k, v) in w.into_iter().enumerate() {
@@ -611,28 +614,28 @@ mod tests {
         }
     }
 
-    struct Gather<'a>(&'a [[f32; 4]], [u32; WIDTH]);
+    struct Indexed<'a>(&'a [[f32; 4]], [u32; WIDTH]);
 
-    impl Kernel for Gather<'_> {
+    impl Kernel for Indexed<'_> {
         type Out = f32;
         fn run<L: Lanes>(self) -> f32 {
-            L::V::gather_records(self.0, &self.1)[0].reduce_max()
+            L::V::load_records_at(self.0, &self.1)[0].reduce_max()
         }
     }
 
-    /// An index past the table's end stops `gather_records` (its one check for all lanes
+    /// An index past the table's end stops `load_records_at` (its one check for all lanes
     /// covers every lane, not only the first or the last), on every ISA; the largest index
     /// still in the table reads it. Control: the same index one lower is accepted.
     #[test]
-    fn gathered_records_are_bounds_checked_on_every_lane() {
+    fn indexed_records_are_bounds_checked_on_every_lane() {
         let table = vec![[1.0f32, 2.0, 3.0, 4.0]; 40];
         for isa in Isa::available() {
             for lane in [0, 7, 8, WIDTH - 1] {
                 let mut at = [0u32; WIDTH];
                 at[lane] = 39;
-                assert_eq!(run(isa, Gather(&table, at)), 1.0, "{isa:?}: control");
+                assert_eq!(run(isa, Indexed(&table, at)), 1.0, "{isa:?}: control");
                 at[lane] = 40;
-                let caught = std::panic::catch_unwind(|| run(isa, Gather(&table, at)));
+                let caught = std::panic::catch_unwind(|| run(isa, Indexed(&table, at)));
                 assert!(caught.is_err(), "{isa:?}: lane {lane} read past the table");
             }
         }
