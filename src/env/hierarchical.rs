@@ -160,45 +160,48 @@ impl HierarchicalWarp {
         }
         // Quad q of the pyramid is quad q % 4 of line q / 4. `m` is the Morton index of the
         // node whose quad this step reads, among the nodes of side `half` (the parent
-        // level's); `line` is its level's first line, so the quad is 4·(tile's first line +
-        // line) + m.
+        // level's); `line` is its level's first line, so the quad is `q` = 4·(tile's first
+        // line + line) + m. Its children's quads are `children` + (0…3), one line: their
+        // address is known before this step's splits, and only the last add waits for them.
         let first = tile.mul(V::splat((4 * self.block) as f32));
-        let (mut x, mut y, mut m) = (zero, zero, zero);
+        let (two, three, four) = (V::splat(2.0), V::splat(3.0), V::splat(4.0));
+        let (mut x, mut y, mut m, mut q) = (zero, zero, zero, first);
         let (mut half, mut line) = (1usize, 0usize);
         let mut at = [0u32; N];
         while half < self.n {
             // The next level's line for this node's children (whichever the splits choose).
             let next = line + (half * half).div_ceil(4);
+            let children = first.add(V::splat((4 * next) as f32)).add(m.mul(four));
             if 2 * half < self.n {
-                first
-                    .add(V::splat((4 * next) as f32))
-                    .add(m.mul(V::splat(4.0)))
-                    .trunc_u32(&mut at);
-                for &q in &at {
-                    crate::simd::prefetch(self.pyramid.as_ptr().wrapping_add(q as usize / 4));
+                children.trunc_u32(&mut at);
+                for &c in &at {
+                    crate::simd::prefetch(self.pyramid.as_ptr().wrapping_add(c as usize / 4));
                 }
             }
-            first
-                .add(V::splat((4 * line) as f32))
-                .add(m)
-                .trunc_u32(&mut at);
+            q.trunc_u32(&mut at);
             if 2 * half == self.n {
-                let two = V::splat(2.0);
                 before_last_level(
                     x.add(tile.mul(V::splat((self.n / 2) as f32))).mul(two),
                     y.mul(two),
                 );
             }
             let [c00, c10, c01, c11] = gather::<V, N>(&self.pyramid, &at);
-            let (px, u0n) = split(c00.add(c01), c10.add(c11), u0);
-            // The left column where u₀ < p (as `split` chose).
-            let (top, bottom) = (u0.lt_select(px, c00, c10), u0.lt_select(px, c01, c11));
-            let (py, u1n) = split(top, bottom, u1);
+            let (left, right) = (c00.add(c01), c10.add(c11));
+            let px = first_half(left, right);
+            // Both columns' top/bottom splits, the chosen one picked after: they do not wait
+            // for px (a division shorter per level's chain of dependent steps), and the chosen
+            // one is the same division of the same sums as splitting the chosen column alone.
+            let py = u0.lt_select(px, of_column(c00, left), of_column(c10, right));
+            // The left column where u₀ < px, the top row where u₁ < py (as `rescale` chooses);
+            // `off` is the chosen child's place in its quad, (0, 1, 2, 3) = (x, y) in
+            // (0, 0), (1, 0), (0, 1), (1, 1).
             let (r, d) = (u0.lt_select(px, zero, one), u1.lt_select(py, zero, one));
+            let off = u1.lt_select(py, r, u0.lt_select(px, two, three));
+            (u0, u1) = (rescale(u0, px), rescale(u1, py));
             x = x.add(x).add(r);
             y = y.add(y).add(d);
-            m = m.mul(V::splat(4.0)).add(r).add(d.add(d));
-            (u0, u1) = (u0n, u1n);
+            m = m.mul(four).add(off);
+            q = children.add(off);
             line = next;
             half *= 2;
         }
@@ -249,16 +252,32 @@ fn morton(x: usize, y: usize) -> usize {
     m
 }
 
-/// Per lane, the probability p = a/(a + b) of the first half, chosen where u < p, and u
-/// rescaled into the chosen half. Only called on nodes of positive sum. The divisor is never
-/// zero: the first half is chosen only when u < p, so p > 0; the second only when u ≥ p, and
-/// p = 1 exactly when b = 0 (a/a), which no u < 1 reaches, so 1 − p > 0.
+/// Per lane, the probability p = a/(a + b) of the first half of a node of positive sum
+/// a + b (the only nodes a descent splits).
 #[inline(always)]
-fn split<V: Vector<N>, const N: usize>(a: V, b: V, u: V) -> (V, V) {
-    let p = a.div(a.add(b));
+fn first_half<V: Vector<N>, const N: usize>(a: V, b: V) -> V {
+    a.div(a.add(b))
+}
+
+/// The probability c/column of a column's top texel, where `column` is its sum: as
+/// [`first_half`] (c, column − c) for a column of positive sum. A column of zero sum is
+/// never chosen, and its lanes divide 0 by 1, not by 0: the pair is split before the column
+/// is, and no lane's value is NaN.
+#[inline(always)]
+fn of_column<V: Vector<N>, const N: usize>(c: V, column: V) -> V {
+    let one = V::splat(1.0);
+    c.div(column.le_select(V::splat(0.0), one, column))
+}
+
+/// u rescaled into the half a split by p chooses: [0, p) → [0, 1) where u < p, [p, 1) →
+/// [0, 1) otherwise. The divisor is never zero: the first half is chosen only when u < p, so
+/// p > 0; the second only when u ≥ p, and p = 1 exactly when the second half's sum is 0
+/// (a/a), which no u < 1 reaches, so 1 − p > 0.
+#[inline(always)]
+fn rescale<V: Vector<N>, const N: usize>(u: V, p: V) -> V {
     let num = u.lt_select(p, u, u.sub(p));
     let den = u.lt_select(p, p, V::splat(1.0).sub(p));
-    (p, num.div(den).min(V::splat(ONE_MINUS_EPSILON)))
+    num.div(den).min(V::splat(ONE_MINUS_EPSILON))
 }
 
 #[cfg(test)]
@@ -339,6 +358,27 @@ mod tests {
         let mut tile_off = warp.clone();
         tile_off.tile_cdf[1] *= 0.9;
         assert!(frequency_mismatch(&tile_off, &w).is_some());
+    }
+
+    /// A 2×2 node with one black column (every quad here: the even columns are black) is
+    /// split by the other column's top/bottom probability; the black column's, computed
+    /// beside it and not chosen, is 0, not 0/0 (`of_column` dividing by the column's sum
+    /// as it is fails the second assertion: NaN).
+    #[test]
+    fn a_black_column_splits_without_nan() {
+        let (tiles, n) = (1, 8);
+        let w: Vec<f32> = atlas(tiles, n)
+            .iter()
+            .enumerate()
+            .map(|(k, &x)| if k % 2 == 0 { 0.0 } else { x })
+            .collect();
+        let warp = HierarchicalWarp::new(&w, tiles, n).unwrap();
+        assert_eq!(frequency_mismatch(&warp, &w), None);
+        assert_eq!(of_column::<f32, 1>(0.0, 0.0), 0.0);
+        assert_eq!(
+            of_column::<f32, 1>(1.0, 4.0),
+            first_half::<f32, 1>(1.0, 3.0)
+        );
     }
 
     struct Lanes16<'a>(&'a HierarchicalWarp, [f32; WIDTH], [f32; WIDTH]);
