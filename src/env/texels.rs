@@ -38,6 +38,12 @@ impl TexelMap {
     /// 4×4 midpoint rule), so the map's integral over the sphere matches the source's.
     pub fn resample(repr: Repr, tile: usize, radiance: &(dyn Fn(Vec3) -> Vec3 + Sync)) -> Self {
         let (width, height) = (repr.tiles() * tile, tile);
+        // Texel numbers over lanes are u32 (`index_lanes_u32`); every texel size a scene or
+        // the χ² command can ask for is far below (12·512² at most).
+        assert!(
+            width < 1 << 24 && height < 1 << 24 && width * height <= u32::MAX as usize,
+            "an atlas of {width}×{height} texels is past u32 texel numbers"
+        );
         let texels = (0..width * height)
             .into_par_iter()
             .map(|k| {
@@ -74,6 +80,13 @@ impl TexelMap {
     /// [`Self::index`] of N lanes.
     #[inline(always)]
     pub fn index_lanes<V: Vector<N>, const N: usize>(&self, u: V, v: V) -> [usize; N] {
+        self.index_lanes_u32::<V, N>(u, v).map(|k| k as usize)
+    }
+
+    /// [`Self::index_lanes`] as u32 (`resample` keeps atlases below 2³² texels), the form
+    /// [`Vector::load_records_at`] reads records by.
+    #[inline(always)]
+    pub fn index_lanes_u32<V: Vector<N>, const N: usize>(&self, u: V, v: V) -> [u32; N] {
         // `(u·width as usize).min(width − 1)` and the same for v, over lanes: clamped in f32
         // to [0, side − 1], then truncated. The same integers for every input: the sides are
         // below 2²⁴ (so side − 1 is an f32), MAXPS takes NaN and −0 to 0 as `as` does, and a
@@ -82,9 +95,9 @@ impl TexelMap {
         let (mut x, mut y) = ([0u32; N], [0u32; N]);
         texel_coordinate(u, self.width).trunc_u32(&mut x);
         texel_coordinate(v, self.height).trunc_u32(&mut y);
-        let mut k = [0usize; N];
+        let mut k = [0u32; N];
         for i in 0..N {
-            k[i] = y[i] as usize * self.width + x[i] as usize;
+            k[i] = y[i] * self.width as u32 + x[i];
         }
         k
     }
@@ -132,7 +145,7 @@ pub struct ImportanceMap {
 }
 
 /// Four texel records in one cache line.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C, align(64))]
 struct RecordLine([[f32; 4]; 4]);
 
@@ -188,6 +201,12 @@ impl ImportanceMap {
     #[inline(always)]
     fn record(&self, k: usize) -> &[f32; 4] {
         &self.records[k / 4].0[k % 4]
+    }
+
+    /// Every texel's record, texel k at k (see `records`), for [`Vector::load_records_at`].
+    #[inline(always)]
+    fn record_table(&self) -> &[[f32; 4]] {
+        bytemuck::cast_slice(&self.records)
     }
 
     /// Texel k's density over the atlas (see `records`).
@@ -305,12 +324,12 @@ impl ImportanceMap {
             EnvSampler::Cdf => self.cdf_uv_lanes::<V, WIDTH>(self.cdf.as_ref()?, u0, u1),
             EnvSampler::Hierarchical => self.hier_uv::<V, WIDTH>(self.hier.as_ref()?, u0, u1),
         };
-        let k = t.index_lanes::<V, WIDTH>(u, v);
+        let k = t.index_lanes_u32::<V, WIDTH>(u, v);
         let jac = latlong::jacobian_lanes(v);
         let (x, y, z) = latlong::uv_to_dir_lanes(u, v);
         let mut out = EnvLanes::default();
         V3 { x, y, z }.store(&mut out.wi);
-        let [r, g, b, density] = V::load_records(&std::array::from_fn(|i| self.record(k[i])));
+        let [r, g, b, density] = V::load_records_at(self.record_table(), &k);
         V3 { x: r, y: g, z: b }.store(&mut out.radiance);
         let zero = V::splat(0.0);
         // As the scalar sampler's weight > 0 (see `records`).
@@ -404,17 +423,14 @@ impl ImportanceMap {
                 let w = V3::<L::V>::load(self.1);
                 let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
                 let jac = latlong::jacobian_lanes(v);
-                let k = map.texels.index_lanes::<L::V, WIDTH>(u, v);
-                let mut density = [0.0f32; WIDTH];
-                for lane in 0..WIDTH {
-                    if mask >> lane & 1 != 0 {
-                        density[lane] = map.density(k[lane]);
-                    }
-                }
+                let k = map.texels.index_lanes_u32::<L::V, WIDTH>(u, v);
+                // Every lane's record (a lane outside `mask` has a texel too: indices are
+                // clamped to the atlas), the others' pdfs zeroed after.
+                let [_, _, _, density] = L::V::load_records_at(map.record_table(), &k);
                 // J ≤ 0 (at the poles) has pdf 0, as in the scalar pdf; other lanes divide by 1.
                 let zero = L::V::splat(0.0);
-                let positive = zero.lt(jac);
-                let pdf = L::V::load(&density).div(L::V::select(positive, jac, L::V::splat(1.0)));
+                let positive = zero.lt(jac) & mask;
+                let pdf = density.div(L::V::select(positive, jac, L::V::splat(1.0)));
                 let mut out = [0.0f32; WIDTH];
                 L::V::select(positive, pdf, zero).store(&mut out);
                 out
