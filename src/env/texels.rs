@@ -92,6 +92,7 @@ impl TexelMap {
         // below 2²⁴ (so side − 1 is an f32), MAXPS takes NaN and −0 to 0 as `as` does, and a
         // value truncates to at most side − 1 exactly when it is clamped to it.
         debug_assert!(self.width < 1 << 24 && self.height < 1 << 24);
+        debug_assert!(self.width * self.height <= u32::MAX as usize);
         let (mut x, mut y) = ([0u32; N], [0u32; N]);
         texel_coordinate(u, self.width).trunc_u32(&mut x);
         texel_coordinate(v, self.height).trunc_u32(&mut y);
@@ -423,12 +424,14 @@ impl ImportanceMap {
                 let w = V3::<L::V>::load(self.1);
                 let (u, v) = latlong::dir_to_uv_lanes(w.x, w.y, w.z);
                 let jac = latlong::jacobian_lanes(v);
-                let k = map.texels.index_lanes_u32::<L::V, WIDTH>(u, v);
-                // Every lane's record (a lane outside `mask` has a texel too: indices are
-                // clamped to the atlas), the others' pdfs zeroed after.
+                // Every lane reads a record, a lane outside `mask` texel 0's (its direction
+                // may be anything, and its record would be a read at random in 2 MB that
+                // nothing prefetched); their pdfs are zeroed after.
+                let zero = L::V::splat(0.0);
+                let (ku, kv) = (L::V::select(mask, u, zero), L::V::select(mask, v, zero));
+                let k = map.texels.index_lanes_u32::<L::V, WIDTH>(ku, kv);
                 let [_, _, _, density] = L::V::load_records_at(map.record_table(), &k);
                 // J ≤ 0 (at the poles) has pdf 0, as in the scalar pdf; other lanes divide by 1.
-                let zero = L::V::splat(0.0);
                 let positive = zero.lt(jac) & mask;
                 let pdf = density.div(L::V::select(positive, jac, L::V::splat(1.0)));
                 let mut out = [0.0f32; WIDTH];
