@@ -14,6 +14,7 @@
 //! product of the f32 splits, w/Σw to within a few ulps per level; the pdf the map states is
 //! w/Σw of the texel the point lands in, which is what the χ² tests hold the samples to.
 
+use super::{RecordLine, record_table};
 use crate::sampling::stream::ONE_MINUS_EPSILON;
 use crate::simd::Vector;
 
@@ -29,15 +30,10 @@ pub struct HierarchicalWarp {
     /// one 64-byte line: a descent step reads one quad, and the line of the next step's
     /// quad is known (and prefetched) before the step's splits are computed. Each level
     /// starts on a line; tile t's levels start at line t·`block`.
-    pyramid: Vec<Line>,
+    pyramid: Vec<RecordLine>,
     /// Lines per tile.
     block: usize,
 }
-
-/// Four quads in one cache line.
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[repr(C, align(64))]
-struct Line([[f32; 4]; 4]);
 
 /// The chosen atlas texels of N lanes, (column, row) as whole numbers in f32 (exact: see
 /// [`HierarchicalWarp::new`]), and the offsets (du, dv) ∈ [0, 1)² inside them.
@@ -218,17 +214,17 @@ impl HierarchicalWarp {
 /// table), as four vectors, one per texel of the quad ([`Vector::load_records_at`]: each quad
 /// read whole, transposed in registers).
 #[inline(always)]
-fn gather<V: Vector<N>, const N: usize>(lines: &[Line], q: &[u32; N]) -> [V; 4] {
-    V::load_records_at(bytemuck::cast_slice(lines), q)
+fn gather<V: Vector<N>, const N: usize>(lines: &[RecordLine], q: &[u32; N]) -> [V; 4] {
+    V::load_records_at(record_table(lines), q)
 }
 
 /// A level of side s (row-major, f64 sums) as the 2×2 quads of its parent level's nodes, in
 /// f32, the parent nodes in Morton order (bits of x at even positions, of y at odd ones),
 /// four quads to a line (the last line padded).
-fn quads(level: &[f64]) -> Vec<Line> {
+fn quads(level: &[f64]) -> Vec<RecordLine> {
     let s = level.len().isqrt();
     let h = s / 2;
-    let mut lines = vec![Line::default(); (h * h).div_ceil(4)];
+    let mut lines = vec![RecordLine::default(); (h * h).div_ceil(4)];
     for py in 0..h {
         for px in 0..h {
             let (x, y, m) = (2 * px, 2 * py, morton(px, py));

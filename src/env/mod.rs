@@ -22,6 +22,19 @@ pub mod texels;
 use glam::Vec3;
 pub use texels::{EnvLanes, EnvSample, ImportanceMap, TexelMap};
 
+/// Four 16-byte records (a texel's radiance and density, a pyramid node's four child sums) in
+/// one aligned 64-byte cache line, so records read together can share a line.
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C, align(64))]
+struct RecordLine([[f32; 4]; 4]);
+
+/// The lines' records as one flat table, record k (slot k % 4 of line k / 4) at k: the form
+/// [`crate::simd::Vector::load_records_at`] reads.
+#[inline(always)]
+fn record_table(lines: &[RecordLine]) -> &[[f32; 4]] {
+    bytemuck::cast_slice(lines)
+}
+
 /// A parameterization of the sphere of directions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Repr {

@@ -4,7 +4,7 @@
 use super::cdf::MarginalConditional;
 use super::hierarchical::HierarchicalWarp;
 use super::latlong::{self, below_one};
-use super::{EnvSampler, Repr};
+use super::{EnvSampler, RecordLine, Repr};
 use crate::math::luminance;
 use crate::sampling::stream::ONE_MINUS_EPSILON;
 use crate::simd::{self, Isa, Kernel, Lanes, Soa3, V3, Vector, WIDTH};
@@ -145,11 +145,6 @@ pub struct ImportanceMap {
     hier: Option<HierarchicalWarp>,
 }
 
-/// Four texel records in one cache line.
-#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
-#[repr(C, align(64))]
-struct RecordLine([[f32; 4]; 4]);
-
 /// Environment samples of 16 lanes (structure of arrays); `valid` marks the lanes with one.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct EnvLanes {
@@ -201,13 +196,13 @@ impl ImportanceMap {
     /// Texel k's record: its radiance and density (see `records`).
     #[inline(always)]
     fn record(&self, k: usize) -> &[f32; 4] {
-        &self.records[k / 4].0[k % 4]
+        &self.record_table()[k]
     }
 
     /// Every texel's record, texel k at k (see `records`), for [`Vector::load_records_at`].
     #[inline(always)]
     fn record_table(&self) -> &[[f32; 4]] {
-        bytemuck::cast_slice(&self.records)
+        super::record_table(&self.records)
     }
 
     /// Texel k's density over the atlas (see `records`).
