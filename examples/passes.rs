@@ -25,7 +25,9 @@ fn main() -> Result<(), String> {
     };
     let groups: u64 = groups
         .parse()
-        .map_err(|_| format!("GROUPS: `{groups}` is not a whole number"))?;
+        .ok()
+        .filter(|&g| g > 0)
+        .ok_or_else(|| format!("GROUPS: `{groups}` is not a whole number above 0"))?;
     let path = Scene::resolve(scene).map_err(|e| e.to_string())?;
     let loaded = Scene::load(&path).map_err(|e| e.to_string())?;
     let prepared = PreparedScene::with_tracer(loaded, |g| {
