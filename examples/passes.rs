@@ -1,7 +1,7 @@
 //! Renders groups of 16 passes of one strategy on one scene, as `compare` renders them once a
 //! pass has been timed (`Renderer::add_passes`: each packet one pixel's 16 samples), and
 //! nothing else: a fixed workload for `scripts/instructions.sh`, which counts the
-//! instructions of `add_passes` under callgrind. (`compare` under valgrind would time its
+//! instructions of `Renderer::add_passes_with_streams` under callgrind. (`compare` under valgrind would time its
 //! passes at valgrind's pace and render them one at a time, packed as 4×4 pixel tiles,
 //! which its timed runs do for the first pass only.)
 //!
@@ -43,8 +43,8 @@ fn main() -> Result<(), String> {
     };
     let mut renderer = Renderer::new(&prepared, s.as_ref(), 1).map_err(|e| e.to_string())?;
     let mut film = Film::new(prepared.scene.width, prepared.scene.height);
-    // One thread, this one: callgrind's collection, switched on per thread by the function
-    // it enters, then sees the tiles' work inside `add_passes`.
+    // One thread, this one: callgrind switches its collection on per thread, on entering the
+    // function it is given, so the tiles' work must run on the thread that enters it.
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .use_current_thread()

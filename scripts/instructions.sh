@@ -9,9 +9,9 @@
 # (default 2) groups of 16 passes with the packet backend on one thread (the calling one),
 # each packet one pixel's 16 samples, as `compare` renders every group after its first pass;
 # callgrind counts inside `Renderer::add_passes_with_streams` only (camera rays, the
-# estimator, its shadow and emission rays, the film; not the scene's preparation). Prints "SCENE STRATEGY
-# INSTRUCTIONS PER-SAMPLE" and the eight functions with the most instructions of their own
-# (inlined code counts where it was inlined). The count is the same from run to run.
+# estimator, its shadow and emission rays, the film; not the scene's preparation). Prints
+# "SCENE STRATEGY INSTRUCTIONS PER-SAMPLE" and the eight source files and functions with the
+# most instructions of their own (inlined code counts where it was inlined). The count is the same from run to run.
 # (Up to stop 58 this script ran `compare --spp 1` under callgrind: one pass, packed in 4×4
 # pixel tiles, and the shading phase alone; its figures are not comparable with these. That
 # version, which reproduces docs/tracer.md's figures of stops 56–58, is
