@@ -15,7 +15,7 @@ use dibench::film::Film;
 use dibench::prepare::PreparedScene;
 use dibench::render::{MAX_GROUP, Renderer};
 use dibench::scene::Scene;
-use dibench::strategy::applicable;
+use dibench::strategy::by_name;
 use dibench::tracer::backends;
 
 fn main() -> Result<(), String> {
@@ -33,14 +33,8 @@ fn main() -> Result<(), String> {
     let prepared = PreparedScene::with_tracer(loaded, |g| {
         backends::build("packet", g).expect("the packet backend always builds")
     });
-    let (strategies, _) = applicable(&prepared);
-    let Some(s) = strategies.iter().find(|s| s.name() == *strategy) else {
-        let names: Vec<_> = strategies.iter().map(|s| s.name()).collect();
-        return Err(format!(
-            "STRATEGY: `{strategy}` does not apply to {scene} (these do: {})",
-            names.join(", ")
-        ));
-    };
+    let s = by_name(strategy).ok_or_else(|| format!("STRATEGY: unknown strategy `{strategy}`"))?;
+    // Says which scene the strategy does not apply to, and why.
     let mut renderer = Renderer::new(&prepared, s.as_ref(), 1).map_err(|e| e.to_string())?;
     let mut film = Film::new(prepared.scene.width, prepared.scene.height);
     // One thread, this one: callgrind switches its collection on per thread, on entering the
